@@ -1,0 +1,205 @@
+"""The Navigation Manager's free-area map: where the robot's centre may go in a house.
+
+The map is computed from the house model, not sensed, so navigation works from the first tick and
+agrees with the pybullet world by construction. Three steps, each its own function:
+
+1. :func:`obstacles` rasterises the house at one robot height: the union of the room floors (plus
+   open doorways) is the known area, everything else is UNKNOWN; wall pieces, columns, closed door
+   leaves and furniture footprints that the robot's body would hit are OCCUPIED; the rest is FREE.
+2. :func:`inflate` grows every non-free cell by the robot radius (a disc), so a FREE cell is a
+   position where the whole robot disc fits: the planner can then treat the robot as a point.
+3. :func:`free_space` chains the two; :func:`distance_to_obstacle` gives the clearance the planner
+   uses to keep paths away from walls where there is room.
+
+Rasterisation uses cv2 polygon filling on sub-pixel coordinates: a few hundred shapes per house take
+milliseconds. An obstacle covers the cells whose centre lies inside it (see :func:`_fill_box`: house
+coordinates sit on cell edges, and cv2's own rounding would narrow every 0.8 m corridor by a cell),
+and a shape thinner than a cell still covers a line of cells, so no wall is lost at any resolution.
+
+Why the union of floors: neighbouring floor polygons meet under each doorway (each reaches half
+way through the threshold), so the known area is connected exactly where the walls have gaps;
+open doors' frame boxes are added to the known area as well, so a doorway never depends on floor
+outlines meeting to the last centimetre.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping, Sequence
+
+import cv2
+import numpy as np
+
+from ravh_sim.errors import UnknownNameError
+from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid
+from ravh_sim.world.geometry import box_corners
+from ravh_sim.world.house import Door, House, HouseObject, Wall
+
+NON_OBSTACLE_TYPES = frozenset({"Door", "Wall", "Light", "Station"})
+"""Object types that never block: doors (handled through ``house.doors``), windows (inside the
+walls), ceiling lights and the robot's own charging station."""
+
+MIN_OBSTACLE_TOP = 0.02
+"""Objects whose top is at most this high above the floor (rugs, thresholds) do not block."""
+
+MIN_DOOR_THICKNESS = 0.1
+_SHIFT = 8                                  # cv2 fixed-point fraction bits
+_SCALE = 1 << _SHIFT
+
+
+def free_space(house: House, door_open: Mapping[str, bool], models: Mapping[str, int] | None = None,
+               radius: float = 0.25, height: float = 1.6, resolution: float = 0.05,
+               margin: float = 0.5) -> Grid:
+    """Cells where a robot disc of ``radius`` and ``height`` fits: FREE, OCCUPIED or UNKNOWN.
+
+    ``door_open`` maps door ids to open (True) or closed; doors it omits keep their default state.
+    ``models`` maps object ids to the model variant shown in the world: pass the resolved settings'
+    ``models`` (inheritance already followed) to match the world; objects it omits use their
+    default model.
+    """
+    return inflate(obstacles(house, door_open, models, height, resolution, margin), radius)
+
+
+def obstacles(house: House, door_open: Mapping[str, bool], models: Mapping[str, int] | None = None,
+              height: float = 1.6, resolution: float = 0.05, margin: float = 0.5) -> Grid:
+    """The uninflated map: known floor FREE, obstacles at robot height OCCUPIED, outside UNKNOWN.
+
+    The grid covers ``house.bounds`` plus ``margin`` on every side, aligned to ``resolution``.
+    """
+    if resolution <= 0 or height <= 0 or margin < 0:
+        raise ValueError(f"need resolution > 0, height > 0, margin >= 0; got {resolution}, "
+                         f"{height}, {margin}")
+    open_state = _door_states(house, door_open)
+    models = _checked_models(house, models or {})
+    grid = _empty_grid(house, resolution, margin)
+    known = np.zeros(grid.shape, np.uint8)
+    for room in house.rooms:
+        for poly in (room.floor, *room.extra_floors):
+            _fill_polygon(known, poly, grid)
+    for door in house.doors:
+        if open_state[door.id]:
+            _fill_box(known, _door_box(door), grid)
+    blocked = np.zeros(grid.shape, np.uint8)
+    for box in _obstacle_boxes(house, open_state, models, height):
+        _fill_box(blocked, box, grid)
+    grid.data[known > 0] = FREE
+    grid.data[blocked > 0] = OCCUPIED
+    return grid
+
+
+def inflate(grid: Grid, radius: float) -> Grid:
+    """A copy of ``grid`` where FREE cells whose centre lies within ``radius`` of the centre of any
+    non-FREE cell (OCCUPIED or UNKNOWN: the robot must not leave the house either) are OCCUPIED."""
+    if radius < 0:
+        raise ValueError(f"radius must be >= 0, got {radius}")
+    data = grid.data.copy()
+    within = _distance_cells(grid.data) <= radius / grid.resolution + 1e-6
+    data[(data == FREE) & within] = OCCUPIED
+    return Grid(data, grid.origin, grid.resolution)
+
+
+def distance_to_obstacle(grid: Grid) -> np.ndarray:
+    """Metres (float32, grid shape) from each cell centre to the nearest non-FREE cell centre;
+    0 on non-FREE cells. On an inflated map this is the clearance beyond the robot radius."""
+    return _distance_cells(grid.data) * np.float32(grid.resolution)
+
+
+# --------------------------------------------------------------------------- shapes
+
+Box = tuple[tuple[float, float], tuple[float, float], float]
+"""A yawed rectangle on the floor: centre (x, y), size (along yaw, across), yaw."""
+
+
+def _obstacle_boxes(house: House, open_state: Mapping[str, bool], models: Mapping[str, int],
+                    height: float) -> Iterator[Box]:
+    """Footprints of everything that blocks a robot of ``height``."""
+    floor_z = {room.id: room.floor_z for room in house.rooms}
+    for wall in house.walls:
+        base = floor_z[wall.room]
+        if wall.z0 < base + height and wall.z1 > base:
+            yield _wall_box(wall)
+    for door in house.doors:
+        if not open_state[door.id]:
+            yield _door_box(door)
+    for obj in house.objects:
+        box = _object_box(obj, models.get(obj.id), floor_z[obj.room], height)
+        if box is not None:
+            yield box
+
+
+def _wall_box(wall: Wall) -> Box:
+    (ax, ay), (bx, by) = wall.a, wall.b
+    return ((ax + bx) / 2, (ay + by) / 2), (wall.length, wall.thickness), math.atan2(by - ay, bx - ax)
+
+
+def _door_box(door: Door) -> Box:
+    """The doorway rectangle: the frame's width along ``yaw``, at least the leaf's thickness deep."""
+    return door.position[:2], (door.width, max(door.leaf[1], MIN_DOOR_THICKNESS)), door.yaw
+
+
+def _object_box(obj: HouseObject, model: int | None, floor_z: float, height: float) -> Box | None:
+    """The footprint of ``obj``'s model box, or None when it cannot touch the robot's body."""
+    if obj.type in NON_OBSTACLE_TYPES:
+        return None
+    box = obj.box(model)
+    bottom, top = box.position[2] - box.size[2] / 2, box.position[2] + box.size[2] / 2
+    if top <= floor_z + MIN_OBSTACLE_TOP or bottom >= floor_z + height:
+        return None
+    return box.position[:2], box.size[:2], obj.yaw
+
+
+# --------------------------------------------------------------------------- raster
+
+def _empty_grid(house: House, resolution: float, margin: float) -> Grid:
+    xmin, ymin, xmax, ymax = house.bounds
+    ox = math.floor((xmin - margin) / resolution) * resolution
+    oy = math.floor((ymin - margin) / resolution) * resolution
+    cols = math.ceil((xmax + margin - ox) / resolution)
+    rows = math.ceil((ymax + margin - oy) / resolution)
+    return Grid(np.full((rows, cols), UNKNOWN, np.int8), (ox, oy), resolution)
+
+
+def _fill_polygon(mask: np.ndarray, outline: Sequence[tuple[float, float]], grid: Grid) -> None:
+    """Set to 1 every cell of ``mask`` that the polygon ``outline`` (metres) touches."""
+    cv2.fillPoly(mask, [_pixels(np.asarray(outline), grid)], 1, lineType=cv2.LINE_8, shift=_SHIFT)
+
+
+def _fill_box(mask: np.ndarray, box: Box, grid: Grid) -> None:
+    """Set to 1 the cells of ``mask`` whose centre lies in ``box``; a box thinner than a cell is
+    drawn as a line one cell wide, so no wall is ever lost between cell centres.
+
+    cv2 fills from the cell nearest one edge to the cell nearest the other, which makes a shape half
+    a cell wider on each side than the set of cell centres inside it; shrinking the box by half a
+    cell per side first removes that bias (which would otherwise narrow every passage by a cell).
+    """
+    center, (length, width), yaw = box
+    shrunk = (max(length - grid.resolution, 0.0), max(width - grid.resolution, 0.0))
+    corners = box_corners(center, shrunk, yaw)
+    cv2.fillConvexPoly(mask, _pixels(corners, grid), 1, lineType=cv2.LINE_8, shift=_SHIFT)
+
+
+def _pixels(points: np.ndarray, grid: Grid) -> np.ndarray:
+    """cv2 fixed-point pixel coordinates of (n, 2) points in metres: cell centres on integers."""
+    pixels = (points - np.asarray(grid.origin)) / grid.resolution - 0.5
+    return np.round(pixels * _SCALE).astype(np.int32)
+
+
+def _distance_cells(data: np.ndarray) -> np.ndarray:
+    """Cells from each cell centre to the nearest non-FREE cell centre (0 on non-FREE cells)."""
+    free = (data == FREE).astype(np.uint8)
+    return cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+
+
+# --------------------------------------------------------------------------- arguments
+
+def _door_states(house: House, door_open: Mapping[str, bool]) -> dict[str, bool]:
+    unknown = [d for d in door_open if d not in house.door_by_id]
+    if unknown:
+        raise UnknownNameError("door", unknown[0], list(house.door_by_id))
+    return {d.id: bool(door_open.get(d.id, d.default_open)) for d in house.doors}
+
+
+def _checked_models(house: House, models: Mapping[str, int]) -> Mapping[str, int]:
+    unknown = [o for o in models if o not in house.object_by_id]
+    if unknown:
+        raise UnknownNameError("object", unknown[0], list(house.object_by_id))
+    return models

@@ -1,0 +1,19 @@
+"""Where the package's data lives: houses, config and robot profiles.
+
+In a source checkout the data sits beside the package (the repository root); installed by pip or
+colcon it sits in <prefix>/share/ravh_sim, three levels above site-packages. One place decides, so
+every module agrees.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+_PACKAGE = Path(__file__).resolve().parent
+_CHECKOUT = _PACKAGE.parent
+_INSTALLED = _PACKAGE.parents[3] / "share" / "ravh_sim" if len(_PACKAGE.parents) > 3 else _CHECKOUT
+DATA_DIR = _CHECKOUT if (_CHECKOUT / "houses").is_dir() else _INSTALLED
+
+HOUSES_DIR = DATA_DIR / "houses"
+CONFIG_DIR = DATA_DIR / "config"
+ROBOTS_DIR = CONFIG_DIR / "robots"
+DEFAULT_CONFIG = CONFIG_DIR / "default.yaml"

@@ -1,0 +1,127 @@
+"""Instances and the footprint: what is in the world, with ids and mask colours, so a run can be reproduced.
+
+The instance table is a pure function of the house and the resolved settings (no pybullet): one entry
+per room surface (floor, ceiling, walls) and per labelled object, in a fixed order, numbered from 1
+(0 means "nothing" in instance images). The footprint is that table with each instance's pose and
+model, plus the resolved settings; :func:`load_footprint` gives back the house number and settings,
+from which the World rebuilds exactly the same scene.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ravh_sim.errors import FileFieldError
+from ravh_sim.world.geometry import polygon_centroid, quaternion_from_yaw
+from ravh_sim.world.house import House
+from ravh_sim.world.settings import Resolved
+
+FOOTPRINT_FORMAT = "ravh_sim/footprint@1"
+STRUCTURE_KINDS = ("floor", "ceiling", "walls")
+
+
+@dataclass
+class Instance:
+    """Something the camera can see, with the id that instance images store."""
+    id: int                        # >= 1
+    name: str                      # object id, or '<room id>/floor|ceiling|walls'
+    kind: str                      # object | door | window | floor | ceiling | walls
+    room: str
+    room_type: str
+    type: str                      # object category (first tag) or the structure kind
+    tags: tuple[str, ...]
+    mask_color: tuple[int, int, int]
+    body: int = -1                 # pybullet body, set by the World
+
+
+def mask_color(instance_id: int) -> tuple[int, int, int]:
+    """A unique colour per id: the id's bits spread over R, G, B from the top bit down, so that
+    consecutive ids get very different colours (and the mapping is invertible)."""
+    rgb = [0, 0, 0]
+    for bit in range(24):
+        if instance_id >> bit & 1:
+            rgb[bit % 3] |= 1 << (7 - bit // 3)
+    return (rgb[0], rgb[1], rgb[2])
+
+
+def build_instances(house: House) -> list[Instance]:
+    """Every instance of ``house`` in its fixed order."""
+    specs: list[tuple[str, str, str, str, tuple[str, ...]]] = []
+    rooms_with_walls = {w.room for w in house.walls}
+    for room in house.rooms:
+        for kind in STRUCTURE_KINDS:
+            if kind != "walls" or room.id in rooms_with_walls:
+                specs.append((f"{room.id}/{kind}", kind, room.id, kind, (kind,)))
+    for obj in house.objects:
+        kind = "door" if obj.id in house.door_by_id else "window" if obj.type == "Wall" else "object"
+        specs.append((obj.id, kind, obj.room, obj.type, obj.tags))
+    return [Instance(i, name, kind, room, house.room(room).type, type_, tags, mask_color(i))
+            for i, (name, kind, room, type_, tags) in enumerate(specs, start=1)]
+
+
+def instance_pose(house: House, settings: Resolved, inst: Instance) -> dict[str, Any]:
+    """Position, orientation and model of an instance under ``settings``."""
+    if inst.kind in STRUCTURE_KINDS:
+        room = house.room(inst.room)
+        cx, cy = polygon_centroid(room.floor)
+        z = {"floor": room.floor_z, "ceiling": room.ceiling_z, "walls": (room.floor_z + room.ceiling_z) / 2}
+        return {"position": _r([cx, cy, z[inst.kind]]), "orientation": [0.0, 0.0, 0.0, 1.0], "yaw": 0.0,
+                "model": None, "size": None}
+    obj = house.object(inst.name)
+    model = settings.models[obj.id]
+    box = obj.box(model)
+    return {"position": _r(box.position), "orientation": _r(quaternion_from_yaw(obj.yaw)),
+            "yaw": _r(obj.yaw), "model": model, "size": _r(box.size)}
+
+
+def make_footprint(house: House, settings: Resolved) -> dict[str, Any]:
+    """The footprint document (JSON-ready)."""
+    rows = []
+    for inst in build_instances(house):
+        row = {"id": inst.id, "name": inst.name, "kind": inst.kind, "mask_color": list(inst.mask_color),
+               "room": inst.room, "room_type": inst.room_type, "type": inst.type, "tags": list(inst.tags)}
+        row.update(instance_pose(house, settings, inst))
+        if inst.kind == "door":
+            row["open"] = settings.doors[inst.name]
+        if inst.name in settings.lights:
+            row["on"] = settings.lights[inst.name]
+        rows.append(row)
+    return {"format": FOOTPRINT_FORMAT, "house": house.number, "settings": settings.to_dict(),
+            "instances": rows}
+
+
+def dump_footprint(footprint: dict[str, Any]) -> str:
+    """Stable text (sorted keys, one instance per line) so equal footprints are byte-identical."""
+    head = {k: v for k, v in footprint.items() if k != "instances"}
+    text = json.dumps(head, sort_keys=True, separators=(",", ":"))[:-1]
+    rows = ",\n".join(json.dumps(r, sort_keys=True, separators=(",", ":")) for r in footprint["instances"])
+    return f'{text},"instances":[\n{rows}\n]}}\n'
+
+
+def write_footprint(footprint: dict[str, Any], path: Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(dump_footprint(footprint))
+
+
+def load_footprint(path: Path) -> tuple[int, Resolved]:
+    """(house number, resolved settings) of a footprint file."""
+    try:
+        data = json.loads(Path(path).read_text())
+    except (OSError, ValueError) as e:
+        raise FileFieldError(path, "-", f"cannot read footprint: {e}") from None
+    if not isinstance(data, dict) or data.get("format") != FOOTPRINT_FORMAT:
+        raise FileFieldError(path, "format", f"expected {FOOTPRINT_FORMAT!r}")
+    try:
+        return int(data["house"]), Resolved.from_dict(data["settings"])
+    except (KeyError, TypeError, ValueError) as e:
+        raise FileFieldError(path, f"settings ({e})", "missing or malformed") from None
+
+
+def _r(values: Any) -> Any:
+    """Round to 0.1 mm (a number or a sequence); + 0.0 turns -0.0 into 0.0 for stable text."""
+    if isinstance(values, (int, float)):
+        return round(float(values), 4) + 0.0
+    return [round(float(v), 4) + 0.0 for v in values]
+

@@ -1,0 +1,284 @@
+"""The World: one pybullet client that holds a whole house.
+
+Like gym-pybullet-drones' BaseAviary, one class owns the physics client: it builds the house from a
+:class:`House` and explicit :class:`Resolved` settings, keeps the table of instances (every labelled
+object, door, window and each room's floor, ceiling and walls, each with a unique id and mask colour)
+and changes the house at run time (doors, object models, paint) without rebuilding it. Sensors, robots
+and the node read the world through this class; nothing else talks to this pybullet client directly.
+"""
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+import pkgutil
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pybullet as pb
+
+from ravh_sim.world import paints
+from ravh_sim.world.facing import choose_facing
+from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances
+from ravh_sim.world.furniture import build_model
+from ravh_sim.world.geometry import quaternion_from_yaw
+from ravh_sim.world.house import Door, House, HouseObject, Wall
+from ravh_sim.world.palette import PALETTE
+from ravh_sim.world.settings import Resolved
+from ravh_sim.world.structure import TexturedMesh, floor_mesh, wall_mesh
+
+RENDERERS = ("auto", "egl", "tiny")
+NON_SOLID_TYPES = frozenset({"Station"})      # drawn, but the robot starts on it
+DOOR_LEAF_THICKNESS = 0.05
+CEILING_PAINT = "white"
+GROUND_HALF_SIZE = 60.0
+
+
+def cache_dir() -> Path:
+    """Where generated meshes and textures go (content-addressed, safe to share between runs)."""
+    root = os.environ.get("RAVH_CACHE") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "ravh_sim")
+    path = Path(root) / "assets"
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+class World:
+    """A house built in its own pybullet client (DIRECT: headless)."""
+
+    def __init__(self, house: House, settings: Resolved, renderer: str = "auto",
+                 physics_hz: float = 240.0) -> None:
+        if renderer not in RENDERERS:
+            raise ValueError(f"renderer must be one of {RENDERERS}, got {renderer!r}")
+        self.house = house
+        self.settings = settings
+        self.physics_hz = physics_hz
+        self.client = pb.connect(pb.DIRECT)
+        self.renderer = self._load_renderer(renderer)
+        pb.setGravity(0, 0, -9.81, physicsClientId=self.client)
+        pb.setTimeStep(1.0 / physics_hz, physicsClientId=self.client)
+        self._assets = cache_dir()
+        self._textures: dict[str, int] = {}
+        self.instances: list[Instance] = []
+        self._by_name: dict[str, Instance] = {}
+        self.triangle_count = 0
+        self._looks: list[tuple[int, int, list[float]]] = []
+        self._building = True
+        self.floor_z = float(np.median([r.floor_z for r in house.rooms]))
+        self._build()
+
+    # ------------------------------------------------------------------ life cycle
+    def close(self) -> None:
+        if self.client >= 0:
+            pb.disconnect(self.client)
+            self.client = -1
+
+    def __enter__(self) -> World:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def _load_renderer(self, wanted: str) -> str:
+        if wanted == "tiny":
+            return "tiny"
+        loader = pkgutil.get_loader("eglRenderer")
+        plugin = -1
+        if loader is not None:
+            plugin = pb.loadPlugin(loader.get_filename(), "_eglRendererPlugin", physicsClientId=self.client)
+        if plugin < 0:
+            print("ravh_sim: EGL rendering unavailable, falling back to TinyRenderer (slower)",
+                  file=sys.stderr)
+            return "tiny"
+        return "egl"
+
+    # ------------------------------------------------------------------ lookups
+    def instance(self, name: str) -> Instance:
+        return self._by_name[name]
+
+    def body_to_instance_lut(self) -> np.ndarray:
+        """Array mapping pybullet body id -> instance id (0 for bodies that are not instances)."""
+        lut = np.zeros(pb.getNumBodies(physicsClientId=self.client) + 64, dtype=np.int32)
+        for inst in self.instances:
+            if inst.body >= 0:
+                if inst.body >= len(lut):
+                    lut = np.pad(lut, (0, inst.body + 64 - len(lut)))
+                lut[inst.body] = inst.id
+        return lut
+
+    # ------------------------------------------------------------------ building
+    def _build(self) -> None:
+        # The ground: a thin slab just under the floors (the robot drives on it; it also shows as the
+        # ground outside). Not a GEOM_PLANE, which crashes pybullet's EGL plugin.
+        ground = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[GROUND_HALF_SIZE, GROUND_HALF_SIZE, 0.05],
+                                         physicsClientId=self.client)
+        pb.createMultiBody(0, ground, -1, basePosition=[0, 0, self.floor_z - 0.051],
+                           physicsClientId=self.client)
+        # Every texture is loaded before the first body: the EGL plugin ignores a texture loaded
+        # between creating a body and changing that body's visual shape.
+        for name in ("palette", "white", *paints.TEXTURES):
+            self._texture(name)
+        self.instances = build_instances(self.house)
+        self._by_name = {inst.name: inst for inst in self.instances}
+        for inst in self.instances:
+            if inst.kind in STRUCTURE_KINDS:
+                inst.body = self._structure_body(inst)
+            else:
+                inst.body = self._object_body(self.house.object(inst.name), self.settings.models[inst.name])
+                if inst.kind == "door":
+                    self.set_door_open(inst.name, self.settings.doors[inst.name])
+        self._building = False
+        self._flush_looks()
+
+    def _structure_body(self, inst: Instance) -> int:
+        room = self.house.room(inst.room)
+        if inst.kind == "walls":
+            walls = [w for w in self.house.walls if w.room == room.id]
+            body = self._mesh_body(wall_mesh(walls), self._wall_collision(walls))
+            self._apply_paint(body, self.settings.paint[room.id]["walls"])
+        elif inst.kind == "floor":
+            body = self._mesh_body(floor_mesh(room, room.floor_z), -1)
+            self._apply_paint(body, self.settings.paint[room.id]["floor"])
+        else:
+            body = self._mesh_body(floor_mesh(room, room.ceiling_z, facing_up=False), -1)
+            self._apply_paint(body, CEILING_PAINT)
+        return body
+
+    def _wall_collision(self, walls: list[Wall]) -> int:
+        half, pos, orn = [], [], []
+        for w in walls:
+            (ax, ay), (bx, by) = w.a, w.b
+            half.append([max(w.length, 0.01) / 2, w.thickness / 2, (w.z1 - w.z0) / 2])
+            pos.append([(ax + bx) / 2, (ay + by) / 2, (w.z0 + w.z1) / 2])
+            orn.append(quaternion_from_yaw(math.atan2(by - ay, bx - ax)))
+        return pb.createCollisionShapeArray([pb.GEOM_BOX] * len(walls), halfExtents=half,
+                                            collisionFramePositions=pos,
+                                            collisionFrameOrientations=orn, physicsClientId=self.client)
+
+    def _object_body(self, obj: HouseObject, model: int) -> int:
+        if obj.id in self.house.door_by_id:
+            return self._door_body(self.house.door_by_id[obj.id], model)
+        box = obj.box(model)
+        walls = [(w.a, w.b) for w in self.house.walls if w.room == obj.room and w.kind != "lintel"]
+        facing = choose_facing(box.position[:2], obj.yaw, box.size, walls)
+        mesh = build_model(obj.type, box.size, model, facing=facing, prefab=obj.prefab)
+        collision = -1
+        if obj.type not in NON_SOLID_TYPES:
+            collision = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[max(s / 2, 0.005) for s in box.size],
+                                                physicsClientId=self.client)
+        return self._palette_body(mesh, collision, box.position, obj.yaw)
+
+    def _door_body(self, door: Door, model: int) -> int:
+        """The door leaf: a slab across the doorway, moved out of the house when the door is open."""
+        width, _, height = door.leaf
+        size = (DOOR_LEAF_THICKNESS, width, height)
+        mesh = build_model("Door", size, model)
+        collision = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[0.05, width / 2, height / 2],
+                                            physicsClientId=self.client)
+        floor = min(self.house.room(r).floor_z for r in door.rooms)
+        pos = (door.position[0], door.position[1], floor + height / 2)
+        return self._palette_body(mesh, collision, pos, door.yaw - math.pi / 2)
+
+    def _palette_body(self, mesh, collision: int, position, yaw: float) -> int:
+        path = self._asset(mesh_bytes(mesh), ".obj", lambda p: mesh.write_obj(p, PALETTE))
+        body = self._file_body(path, collision, position, yaw)
+        self._set_look(body, self._texture("palette"), [1, 1, 1, 1])
+        self.triangle_count += mesh.triangle_count
+        return body
+
+    def _mesh_body(self, mesh: TexturedMesh, collision: int) -> int:
+        key = np.concatenate([mesh.vertices.ravel(), mesh.uvs.ravel()]).round(4).tobytes()
+        path = self._asset(key, ".obj", mesh.write_obj)
+        self.triangle_count += mesh.triangle_count
+        return self._file_body(path, collision, (0, 0, 0), 0.0)
+
+    def _file_body(self, path: Path, collision: int, position, yaw: float) -> int:
+        visual = pb.createVisualShape(pb.GEOM_MESH, fileName=str(path), physicsClientId=self.client)
+        return pb.createMultiBody(0, collision, visual, basePosition=list(position),
+                                  baseOrientation=quaternion_from_yaw(yaw), physicsClientId=self.client)
+
+    def _asset(self, key: bytes, suffix: str, write) -> Path:
+        """A content-addressed file in the asset cache, written atomically if missing."""
+        path = self._assets / (hashlib.sha1(key).hexdigest()[:20] + suffix)
+        if not path.exists():
+            tmp = path.with_name(f"{path.stem}.{os.getpid()}.tmp{suffix}")
+            write(tmp)
+            os.replace(tmp, path)
+        return path
+
+    def _texture(self, name: str) -> int:
+        """pybullet texture id for 'palette', 'white' or a paint texture name (loaded once)."""
+        if name not in self._textures:
+            if name == "palette":
+                path = self._asset(PALETTE.image_rgb().tobytes(), ".png", PALETTE.write_texture)
+            elif name == "white":
+                path = self._asset(b"white", ".png", lambda p: cv2.imwrite(str(p), np.full((4, 4, 3), 255,
+                                                                                             np.uint8)))
+            else:
+                rgb = paints.texture_rgb(name)
+                path = self._asset(rgb.tobytes(), ".png",
+                                   lambda p: cv2.imwrite(str(p), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)))
+            self._textures[name] = pb.loadTexture(str(path), physicsClientId=self.client)
+        return self._textures[name]
+
+    def _apply_paint(self, body: int, paint: str) -> None:
+        if paints.is_texture(paint):
+            texture, rgba = self._texture(paint), [1, 1, 1, 1]
+        else:
+            texture, rgba = self._texture("white"), [c / 255 for c in paints.plain_rgb(paint)] + [1]
+        self._set_look(body, texture, rgba)
+
+    def _set_look(self, body: int, texture: int, rgba: list[float]) -> None:
+        """Texture and colour of a body; queued while building (see :meth:`_flush_looks`)."""
+        self._looks.append((body, texture, rgba))
+        if not self._building:
+            self._flush_looks()
+
+    def _flush_looks(self) -> None:
+        """Apply queued looks. The EGL plugin drops visual changes made to bodies while later bodies
+        are still being created, so a build applies them all once every body exists."""
+        for body, texture, rgba in self._looks:
+            pb.changeVisualShape(body, -1, textureUniqueId=texture, rgbaColor=rgba, physicsClientId=self.client)
+        self._looks.clear()
+
+    # ------------------------------------------------------------------ run-time changes
+    def set_door_open(self, door_id: str, is_open: bool) -> None:
+        """Open (leaf out of the house, as upstream hides it) or close (leaf in the doorway) a door."""
+        door = self.house.door_by_id[door_id]
+        inst = self._by_name[door_id]
+        floor = min(self.house.room(r).floor_z for r in door.rooms)
+        z = floor + door.leaf[2] / 2 if not is_open else floor - 50.0
+        pb.resetBasePositionAndOrientation(inst.body, [door.position[0], door.position[1], z],
+                                           quaternion_from_yaw(door.yaw - math.pi / 2),
+                                           physicsClientId=self.client)
+        self.settings.doors[door_id] = is_open
+
+    def set_object_model(self, object_id: str, model: int) -> None:
+        """Swap an object's model variant (its visual and its collision box)."""
+        inst = self._by_name[object_id]
+        obj = self.house.object(object_id)
+        pb.removeBody(inst.body, physicsClientId=self.client)
+        inst.body = self._object_body(obj, model)
+        self.settings.models[object_id] = model
+        if inst.kind == "door":
+            self.set_door_open(object_id, self.settings.doors[object_id])
+
+    def set_paint(self, room_id: str, surface: str, paint: str) -> None:
+        """Repaint a room's ``walls`` or ``floor``."""
+        self._apply_paint(self._by_name[f"{room_id}/{surface}"].body, paint)
+        self.settings.paint[room_id][surface] = paint
+
+    # ------------------------------------------------------------------ poses
+    def object_pose(self, name: str) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+        """Position and orientation (x, y, z, w) of an instance's body as the world has it now."""
+        pos, orn = pb.getBasePositionAndOrientation(self._by_name[name].body, physicsClientId=self.client)
+        return tuple(pos), tuple(orn)
+
+
+
+def mesh_bytes(mesh) -> bytes:
+    """A content key for a palette mesh."""
+    return (np.asarray(mesh.vertices).round(4).tobytes() + np.asarray(mesh.faces).tobytes()
+            + np.asarray(mesh.colours).tobytes())

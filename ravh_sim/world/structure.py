@@ -1,0 +1,91 @@
+"""Meshes of the building itself: floors, ceilings and walls of each room, UV-mapped in metres.
+
+Unlike furniture (coloured through the palette texture), structure is painted: a plain colour or a
+tiling texture, so its UVs run in world metres divided by the texture's tile size and the renderer
+repeats the texture. Flat normals, one OBJ per room and surface.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ravh_sim.world.geometry import triangulate
+from ravh_sim.world.house import Room, Wall
+from ravh_sim.world.paints import TEXTURE_TILE_M
+
+
+@dataclass
+class TexturedMesh:
+    vertices: np.ndarray     # (N, 3)
+    uvs: np.ndarray          # (N, 2)
+    normals: np.ndarray      # (N, 3)
+    faces: np.ndarray        # (M, 3) int, counter-clockwise from outside
+
+    @property
+    def triangle_count(self) -> int:
+        return len(self.faces)
+
+    def write_obj(self, path: Path) -> None:
+        lines = [f"v {x:.4f} {y:.4f} {z:.4f}" for x, y, z in self.vertices]
+        lines += [f"vt {u:.4f} {v:.4f}" for u, v in self.uvs]
+        lines += [f"vn {x:.4f} {y:.4f} {z:.4f}" for x, y, z in self.normals]
+        lines += [f"f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}" for a, b, c in self.faces + 1]
+        path.write_text("\n".join(lines) + "\n")
+
+
+def merge(meshes: list[TexturedMesh]) -> TexturedMesh:
+    offsets = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
+    return TexturedMesh(np.concatenate([m.vertices for m in meshes]),
+                        np.concatenate([m.uvs for m in meshes]),
+                        np.concatenate([m.normals for m in meshes]),
+                        np.concatenate([m.faces + o for m, o in zip(meshes, offsets)]))
+
+
+def floor_mesh(room: Room, z: float, facing_up: bool = True) -> TexturedMesh:
+    """The room's floor outline(s) as a horizontal surface at height ``z``."""
+    parts = []
+    for poly in (room.floor, *room.extra_floors):
+        pts = np.array(poly, dtype=float)
+        tris = np.array(triangulate(poly), dtype=int).reshape(-1, 3)
+        if not facing_up:
+            tris = tris[:, ::-1]
+        verts = np.column_stack([pts, np.full(len(pts), z)])
+        normal = np.tile([0.0, 0.0, 1.0 if facing_up else -1.0], (len(pts), 1))
+        parts.append(TexturedMesh(verts, pts / TEXTURE_TILE_M, normal, tris))
+    return merge(parts)
+
+
+def wall_mesh(walls: list[Wall]) -> TexturedMesh:
+    """Every wall piece of a room as a box, the texture running along each wall."""
+    return merge([_wall_box(w) for w in walls])
+
+
+def _wall_box(w: Wall) -> TexturedMesh:
+    (ax, ay), (bx, by) = w.a, w.b
+    length = max(math.hypot(bx - ax, by - ay), 1e-3)
+    d = np.array([(bx - ax) / length, (by - ay) / length])
+    n = np.array([-d[1], d[0]]) * w.thickness / 2
+    base = [np.array([ax, ay]) - n, np.array([bx, by]) - n, np.array([bx, by]) + n, np.array([ax, ay]) + n]
+    faces: list[TexturedMesh] = []
+    for k in range(4):                                   # the four vertical sides
+        p, q = base[k], base[(k + 1) % 4]
+        edge = q - p
+        out = np.array([edge[1], -edge[0]]) / max(np.linalg.norm(edge), 1e-9)
+        u0 = float(np.dot(p, d))
+        u1 = u0 + float(np.linalg.norm(edge))
+        faces.append(_quad([(*p, w.z0), (*q, w.z0), (*q, w.z1), (*p, w.z1)],
+                           [(u0, w.z0), (u1, w.z0), (u1, w.z1), (u0, w.z1)], (*out, 0.0)))
+    for z, up in ((w.z1, 1.0), (w.z0, -1.0)):           # top and bottom caps
+        ring = base if up > 0 else base[::-1]
+        faces.append(_quad([(*p, z) for p in ring], [tuple(p) for p in ring], (0.0, 0.0, up)))
+    return merge(faces)
+
+
+def _quad(corners: list[tuple], uvs_m: list[tuple], normal: tuple) -> TexturedMesh:
+    """Two triangles; ``uvs_m`` in metres (scaled to texture tiles here)."""
+    verts = np.array(corners, dtype=float)
+    uv = np.array(uvs_m, dtype=float) / TEXTURE_TILE_M
+    return TexturedMesh(verts, uv, np.tile(normal, (4, 1)), np.array([[0, 1, 2], [0, 2, 3]]))

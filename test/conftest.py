@@ -1,0 +1,28 @@
+"""Shared fixtures: houses are loaded once per session; worlds are built where a test needs pybullet."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+
+UPSTREAM = Path(__file__).resolve().parents[2] / "shared" / "upstream-houses"
+
+
+@pytest.fixture(scope="session")
+def houses():
+    from ravh_sim.world.house import available_houses, load_house
+    return {n: load_house(n) for n in available_houses()}
+
+
+@pytest.fixture(scope="session")
+def default_settings():
+    from ravh_sim.world.settings import load_settings
+    return load_settings()
+
+
+def resolved(house, settings=None, seed=0):
+    from ravh_sim.world.settings import load_settings, resolve
+    return resolve(settings or load_settings(), house, seed)

@@ -1,0 +1,336 @@
+"""Tests for the procedural furniture library: meshes, palette, models and facing."""
+from __future__ import annotations
+
+import itertools
+
+import cv2
+import numpy as np
+import pytest
+
+from ravh_sim.world.facing import choose_facing, side_distances
+from ravh_sim.world.furniture import OBJECT_TYPES, build_model, variant_count
+from ravh_sim.world.mesh import Mesh, box, cylinder, ellipsoid, frustum, rotation_y, rotation_z, rounded_box
+from ravh_sim.world.palette import PALETTE, Palette
+
+# Upstream Robot@VirtualHome model counts per type (from the house data).
+UPSTREAM_MODELS = {
+    'Armchair': 4, 'Bathtub': 1, 'Bed': 5, 'Brush': 1, 'Burner': 1, 'Cabinet': 4, 'Chair': 4, 'Closet': 4,
+    'Counter': 4, 'Cup': 1, 'Decoration': 3, 'Desk': 2, 'Dishwasher': 1, 'Door': 3, 'Dresser': 2, 'Drying': 3,
+    'Keyboard': 1, 'KitchenFurniture': 4, 'Lamp': 4, 'Laptop': 2, 'Light': 2, 'Lighter': 1, 'Microwave': 1,
+    'Mirror': 2, 'Nightstand': 3, 'Oven': 1, 'Picture': 4, 'Pouf': 4, 'Refrigerator': 2, 'Shelf': 3,
+    'ShowerCabin': 1, 'Sink': 2, 'Sofa': 4, 'Standard': 4, 'Station': 1, 'Stool': 4, 'Table': 4, 'Toilet': 1,
+    'Toothbrush': 1, 'Towel': 4, 'Tv': 2, 'Wall': 3, 'Washbasin': 2, 'WashingMachine': 1,
+}
+
+# Typical upstream box sizes (sx, sy, sz) in metres; other types use a generic 0.6 m box.
+TYPICAL = {
+    'Armchair': (0.77, 0.76, 0.62), 'Bed': (1.1, 2.21, 1.03), 'Chair': (0.53, 0.42, 1.01),
+    'Closet': (1.75, 0.66, 2.02), 'Counter': (0.6, 0.58, 0.04), 'Desk': (0.68, 1.47, 0.75),
+    'Door': (0.26, 0.94, 2.5), 'Dresser': (0.9, 0.32, 0.5), 'Drying': (0.1, 0.53, 0.62),
+    'KitchenFurniture': (0.57, 0.71, 0.83), 'Lamp': (0.37, 0.17, 0.38), 'Mirror': (0.68, 0.04, 1.05),
+    'Picture': (0.68, 0.04, 0.48), 'Sofa': (1.98, 0.97, 0.65), 'Standard': (0.39, 0.79, 1.49),
+    'Table': (0.79, 0.72, 0.5), 'Toilet': (0.76, 0.48, 0.95), 'Tv': (0.92, 0.18, 0.62),
+    'Wall': (1.36, 0.17, 1.36), 'Washbasin': (0.58, 0.91, 1.26), 'Cup': (0.07, 0.08, 0.12),
+    'Light': (0.36, 0.36, 0.08), 'Station': (0.5, 0.5, 0.02), 'Shelf': (0.67, 0.24, 0.04),
+    'Burner': (0.58, 0.64, 0.06), 'Keyboard': (0.44, 0.14, 0.03), 'Toothbrush': (0.06, 0.11, 0.2),
+}
+
+PREFABS = {
+    'KitchenFurniture': ['', '1 Door', '2Door', '3 Door', '1 Door Up', '2 Door Up', '3 Door Up', 'Corner',
+                         'Corner Up', 'Sink/Body', 'Sink2/Body', 'Burner and Oven'],
+    'Standard': ['rack_1', 'Tv Table'], 'Sofa': ['Small Sofa', 'Corner Sofa'], 'Chair': ['Chair', 'Chair_office'],
+    'Bathtub': ['Bathtub', 'Bathtub 2'],
+}
+
+ALL_TYPES = list(OBJECT_TYPES) + ['SomethingUnknown']
+
+
+def typical(object_type: str) -> tuple[float, float, float]:
+    return TYPICAL.get(object_type, (0.6, 0.5, 0.7))
+
+
+def sizes_for(object_type: str) -> list[tuple[float, float, float]]:
+    sx, sy, sz = typical(object_type)
+    return [(sx, sy, sz), (sy, sx, sz), (0.01, 0.01, 0.01), (0.01, 2.0, 0.5), (2.5, 0.3, 0.02)]
+
+
+def check_model(mesh: Mesh, size: tuple[float, float, float]) -> None:
+    half = np.asarray(size) / 2
+    assert np.isfinite(mesh.vertices).all()
+    assert (np.abs(mesh.vertices) <= half + 1e-6).all(), 'model leaves its box'
+    lo, hi = mesh.bounds()
+    assert ((hi - lo) >= 0.9 * np.asarray(size)).all(), 'model does not fill its box'
+    assert mesh.face_areas().min() > 1e-12 * max(size) ** 2, 'degenerate triangle'
+    assert mesh.colours.min() >= 0 and mesh.colours.max() < len(PALETTE)
+    assert mesh.faces.min() >= 0 and mesh.faces.max() < len(mesh.vertices)
+    assert mesh.signed_volume() > 0, 'faces wind inwards'
+
+
+# --- models ------------------------------------------------------------------------------
+
+@pytest.mark.parametrize('object_type', ALL_TYPES)
+def test_models_fit_their_box_for_every_variant_size_and_facing(object_type):
+    for prefab in PREFABS.get(object_type, ['']):
+        for variant, size, facing in itertools.product(range(variant_count(object_type)), sizes_for(object_type),
+                                                       range(4)):
+            mesh = build_model(object_type, size, variant, facing, prefab)
+            check_model(mesh, size)
+            assert mesh.triangle_count <= 500
+
+
+@pytest.mark.parametrize('object_type', ALL_TYPES)
+def test_typical_models_stay_within_triangle_budget(object_type):
+    for prefab in PREFABS.get(object_type, ['']):
+        for variant in range(variant_count(object_type)):
+            assert build_model(object_type, typical(object_type), variant, 0, prefab).triangle_count <= 400
+
+
+def test_average_model_is_cheap():
+    counts = [build_model(t, typical(t), v).triangle_count for t in OBJECT_TYPES for v in range(variant_count(t))]
+    assert np.mean(counts) <= 250
+
+
+def test_variant_counts_follow_upstream_model_counts():
+    assert set(OBJECT_TYPES) == set(UPSTREAM_MODELS)
+    for object_type, upstream in UPSTREAM_MODELS.items():
+        assert variant_count(object_type) == (max(3, upstream) if upstream > 1 else 1), object_type
+    assert variant_count('SomethingUnknown') == 1
+
+
+def same_mesh(a: Mesh, b: Mesh) -> bool:
+    return (a.vertices.shape == b.vertices.shape and a.faces.shape == b.faces.shape
+            and np.allclose(a.vertices, b.vertices) and np.array_equal(a.faces, b.faces)
+            and np.array_equal(a.colours, b.colours))
+
+
+@pytest.mark.parametrize('object_type', [t for t in OBJECT_TYPES if variant_count(t) > 1])
+def test_variants_differ(object_type):
+    for prefab in PREFABS.get(object_type, ['']):
+        meshes = [build_model(object_type, typical(object_type), v, 0, prefab) for v in range(variant_count(object_type))]
+        for a, b in itertools.combinations(range(len(meshes)), 2):
+            assert not same_mesh(meshes[a], meshes[b]), f'{object_type} {prefab!r} variants {a} and {b} look the same'
+
+
+def test_variant_index_wraps_and_facing_wraps():
+    assert same_mesh(build_model('Chair', (0.5, 0.5, 1.0), 5), build_model('Chair', (0.5, 0.5, 1.0), 1))
+    assert same_mesh(build_model('Chair', (0.5, 0.5, 1.0), 0, 6), build_model('Chair', (0.5, 0.5, 1.0), 0, 2))
+
+
+@pytest.mark.parametrize('object_type', ['Bed', 'KitchenFurniture', 'Picture', 'Lamp'])
+def test_models_are_deterministic(object_type, tmp_path):
+    a = build_model(object_type, typical(object_type), 1, 3)
+    b = build_model(object_type, typical(object_type), 1, 3)
+    assert np.array_equal(a.vertices, b.vertices) and np.array_equal(a.faces, b.faces)
+    assert np.array_equal(a.colours, b.colours)
+    a.write_obj(tmp_path / 'a.obj', PALETTE)
+    b.write_obj(tmp_path / 'b.obj', PALETTE)
+    assert (tmp_path / 'a.obj').read_bytes() == (tmp_path / 'b.obj').read_bytes()
+
+
+def test_bad_sizes_still_give_a_model():
+    for size in [(0.0, 0.5, 0.5), (-0.4, 0.5, 0.5), (float('nan'), 0.5, 0.5)]:
+        mesh = build_model('Chair', size, 0)
+        assert np.isfinite(mesh.vertices).all() and mesh.face_areas().min() > 0
+
+
+FACING_DIRECTIONS = np.array([(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)])
+
+
+def centroid_of(mesh: Mesh, mask: np.ndarray) -> np.ndarray:
+    return mesh.vertices[np.unique(mesh.faces[mask])].mean(axis=0)
+
+
+@pytest.mark.parametrize('facing', range(4))
+def test_chair_back_is_opposite_its_facing(facing):
+    size = (0.5, 0.5, 1.0)
+    mesh = build_model('Chair', size, 0, facing)
+    top = mesh.vertices[:, 2] > 0.3  # only the chair back rises this high
+    back = mesh.vertices[top, :2].mean(axis=0)
+    assert np.dot(back, FACING_DIRECTIONS[facing]) < -0.1
+
+
+@pytest.mark.parametrize('facing', range(4))
+@pytest.mark.parametrize('size', [(1.1, 2.2, 1.0), (2.2, 1.1, 1.0)])
+def test_bed_headboard_is_at_an_end_of_the_long_axis(size, facing):
+    mesh = build_model('Bed', size, 0, facing)
+    top = mesh.vertices[mesh.vertices[:, 2] > 0.45, :2].mean(axis=0)  # only the headboard is that tall
+    long_axis = int(np.argmax(size[:2]))
+    assert abs(top[long_axis]) > 0.4 * size[long_axis]
+    if facing % 2 == long_axis:  # facing agrees with the box: headboard on the back end
+        assert np.dot(top, FACING_DIRECTIONS[facing]) < 0
+
+
+@pytest.mark.parametrize('facing', range(4))
+def test_tv_screen_looks_along_its_facing(facing):
+    size = (0.9, 0.2, 0.6) if facing % 2 else (0.2, 0.9, 0.6)
+    mesh = build_model('Tv', size, 0, facing)
+    screen = mesh.colours == PALETTE.index('screen')
+    bezel = mesh.colours == PALETTE.index('charcoal')
+    direction = FACING_DIRECTIONS[facing]
+    cross = mesh.face_cross()[screen]
+    normal = cross[np.argmax(np.linalg.norm(cross, axis=1))]
+    assert abs(np.dot(normal[:2], direction)) / np.linalg.norm(normal) > 0.99  # the panel is across the facing
+    assert np.dot(centroid_of(mesh, screen)[:2] - centroid_of(mesh, bezel)[:2], direction) > 0  # and in front
+
+
+def test_flat_wall_items_face_across_their_thin_axis():
+    mesh = build_model('Mirror', (0.68, 0.04, 1.05), 0, facing=0)  # facing contradicts the thin axis
+    glass = mesh.colours == PALETTE.index('mirror')
+    cross = mesh.face_cross()[glass]
+    normal = cross[np.argmax(np.linalg.norm(cross, axis=1))]
+    assert abs(normal[1]) / np.linalg.norm(normal) > 0.99
+
+
+# --- mesh --------------------------------------------------------------------------------
+
+PRIMITIVES = {
+    'box': lambda: box((1.0, 2.0, 3.0), (0.4, 0.6, 0.8), 3),
+    'cylinder_z': lambda: cylinder((1.0, 2.0, 3.0), 0.3, 0.8, 3),
+    'cylinder_x': lambda: cylinder((1.0, 2.0, 3.0), 0.3, 0.8, 3, segments=12, axis='x'),
+    'cylinder_y': lambda: cylinder((1.0, 2.0, 3.0), 0.3, 0.8, 3, axis='y'),
+    'frustum': lambda: frustum((1.0, 2.0, 3.0), 0.3, 0.1, 0.8, 3),
+    'cone': lambda: frustum((1.0, 2.0, 3.0), 0.3, 0.0, 0.8, 3),
+    'rounded_box': lambda: rounded_box((1.0, 2.0, 3.0), (0.4, 0.6, 0.8), 3, 0.05),
+    'ellipsoid': lambda: ellipsoid((1.0, 2.0, 3.0), (0.4, 0.6, 0.8), 3),
+}
+
+
+@pytest.mark.parametrize('name', PRIMITIVES)
+def test_primitives_are_closed_outward_and_centred(name):
+    mesh = PRIMITIVES[name]()
+    lo, hi = mesh.bounds()
+    assert np.allclose((lo + hi) / 2, (1.0, 2.0, 3.0))
+    centroids = mesh.vertices[mesh.faces].mean(axis=1) - (1.0, 2.0, 3.0)
+    assert (np.einsum('ij,ij->i', mesh.face_cross(), centroids) > 0).all(), 'a face points inwards'
+    edges = np.sort(mesh.faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    _, uses = np.unique(edges, axis=0, return_counts=True)
+    assert (uses == 2).all(), 'mesh is not closed'
+    assert mesh.face_areas().min() > 0 and (mesh.colours == 3).all()
+
+
+def test_primitive_extents_and_triangle_counts():
+    assert np.allclose(np.subtract(*box((0, 0, 0), (0.4, 0.6, 0.8), 0).bounds()[::-1]), (0.4, 0.6, 0.8))
+    assert np.allclose(np.subtract(*cylinder((0, 0, 0), 0.3, 0.8, 0).bounds()[::-1]), (0.6, 0.6, 0.8))
+    assert np.allclose(np.subtract(*cylinder((0, 0, 0), 0.3, 0.8, 0, axis='x').bounds()[::-1]), (0.8, 0.6, 0.6))
+    assert np.allclose(np.subtract(*rounded_box((0, 0, 0), (0.4, 0.6, 0.8), 0, 0.1).bounds()[::-1]), (0.4, 0.6, 0.8))
+    assert np.allclose(np.subtract(*ellipsoid((0, 0, 0), (0.4, 0.6, 0.8), 0).bounds()[::-1]), (0.4, 0.6, 0.8))
+    assert box((0, 0, 0), (1, 1, 1), 0).triangle_count == 12
+    assert cylinder((0, 0, 0), 1, 1, 0, segments=10).triangle_count == 36
+    assert rounded_box((0, 0, 0), (1, 1, 1), 0, 0.1).triangle_count == 44
+
+
+def test_merge_offsets_faces_and_keeps_colours():
+    a, b = box((0, 0, 0), (1, 1, 1), 1), cylinder((5, 0, 0), 1, 1, 2)
+    merged = Mesh.merged([a, b])
+    assert merged.triangle_count == a.triangle_count + b.triangle_count
+    assert np.allclose(merged.vertices[merged.faces[a.triangle_count:]], b.vertices[b.faces])
+    assert list(np.unique(merged.colours)) == [1, 2]
+
+
+def test_transform_rotates_translates_and_keeps_winding_under_mirroring():
+    mesh = box((1.0, 0.0, 0.0), (0.2, 0.4, 0.6), 0)
+    turned = mesh.transformed(np.pi / 2, (0.0, 0.0, 1.0))
+    assert np.allclose(turned.vertices.mean(axis=0), (0.0, 1.0, 1.0))
+    assert np.allclose(np.subtract(*turned.bounds()[::-1]), (0.4, 0.2, 0.6))
+    mirrored = mesh.transformed(np.diag([-1.0, 1.0, 1.0]))
+    assert mirrored.signed_volume() == pytest.approx(mesh.signed_volume())
+    assert np.allclose(rotation_z(np.pi / 2) @ (1, 0, 0), (0, 1, 0))
+    assert np.allclose(rotation_y(np.pi / 2) @ (0, 0, 1), (1, 0, 0))
+
+
+def parse_obj(text: str) -> dict[str, list[list[str]]]:
+    records: dict[str, list[list[str]]] = {}
+    for line in text.splitlines():
+        if line and not line.startswith('#'):
+            key, *values = line.split()
+            records.setdefault(key, []).append(values)
+    return records
+
+
+def test_obj_export_round_trips_geometry_uvs_and_normals(tmp_path):
+    mesh = Mesh.merged([box((0, 0, 0), (1, 2, 3), PALETTE.index('wood_dark')),
+                        frustum((0, 0, 2), 0.5, 0.2, 1.0, PALETTE.index('chrome'), axis='y')])
+    path = tmp_path / 'm.obj'
+    mesh.write_obj(path, PALETTE)
+    obj = parse_obj(path.read_text())
+    vertices = np.array(obj['v'], float)
+    uvs, normals = np.array(obj['vt'], float), np.array(obj['vn'], float)
+    assert np.allclose(vertices, mesh.vertices, atol=1e-5)
+    assert len(obj['f']) == mesh.triangle_count
+    unit = mesh.face_cross() / np.linalg.norm(mesh.face_cross(), axis=1, keepdims=True)
+    for face, corners, colour, normal in zip(mesh.faces, obj['f'], mesh.colours, unit):
+        v, t, n = np.array([c.split('/') for c in corners], int).T - 1
+        assert list(v) == list(face)
+        assert np.allclose(uvs[t], PALETTE.uv(int(colour)), atol=1e-6)
+        assert np.allclose(normals[n], normal, atol=1e-3)
+
+
+# --- palette -----------------------------------------------------------------------------
+
+def test_palette_names_are_unique_and_fit_the_texture():
+    assert len(set(PALETTE.names)) == len(PALETTE) <= PALETTE.cell_count
+    assert len(PALETTE) >= 40
+    for i, name in enumerate(PALETTE.names):
+        assert PALETTE.index(name) == i
+    with pytest.raises(KeyError):
+        PALETTE.index('no_such_colour')
+
+
+def test_palette_uv_samples_its_colour_from_the_written_texture(tmp_path):
+    path = tmp_path / 'palette.png'
+    PALETTE.write_texture(path)
+    image = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    height, width = image.shape[:2]
+    assert min(width // PALETTE.cell_count, height) >= 8
+    for i in range(len(PALETTE)):
+        u, v = PALETTE.uv(i)
+        expected = np.round(PALETTE.rgb[i] * 255)[::-1]  # BGR on disk
+        for row in (int((1.0 - v) * height), int(v * height)):  # either image row order
+            for du in (-3, 0, 3):  # and a few texels around the centre, as filtering would
+                assert np.array_equal(image[min(row, height - 1), int(u * width) + du], expected), PALETTE.names[i]
+
+
+def test_palette_rejects_too_many_colours():
+    with pytest.raises(ValueError):
+        Palette(tuple((f'c{i}', (0.0, 0.0, 0.0)) for i in range(5)), cell_count=4)
+
+
+# --- facing ------------------------------------------------------------------------------
+
+def wall_beside(center: np.ndarray, yaw: float, side: int, gap: float, size: tuple[float, float]) -> tuple:
+    """A 3 m wall parallel to the box side ``side`` (0..3 = local +x, +y, -x, -y), ``gap`` metres away."""
+    angle = yaw + side * np.pi / 2
+    normal = np.array([np.cos(angle), np.sin(angle)])
+    tangent = np.array([-normal[1], normal[0]])
+    mid = center + normal * (size[side % 2] / 2 + gap)
+    return tuple(mid - 1.5 * tangent), tuple(mid + 1.5 * tangent)
+
+
+@pytest.mark.parametrize('yaw', [0.0, 0.3, np.pi / 2, 2.5, -np.pi])
+@pytest.mark.parametrize('back_side', range(4))
+def test_front_points_away_from_the_nearest_wall(yaw, back_side):
+    center, size = np.array([1.0, -2.0]), (0.8, 0.5, 1.0)
+    walls = [wall_beside(center, yaw, back_side, 0.05, size), wall_beside(center, yaw, (back_side + 1) % 4, 0.6, size)]
+    assert choose_facing(center, yaw, size, walls) == (back_side + 2) % 4
+
+
+def test_facing_ignores_walls_beside_the_sweep_and_parallel_to_it():
+    size = (0.6, 0.6, 1.0)
+    beside = [((0.5, 2.0), (0.5, 5.0))]  # off to the side, not in front of the +x face
+    assert np.isinf(side_distances((0.0, 0.0), 0.0, size, beside)).all()
+    along = [((-3.0, 0.1), (3.0, 0.1))]  # runs through the box along x: cannot be behind the +-x faces
+    distances = side_distances((0.0, 0.0), 0.0, size, along)
+    assert np.isinf(distances[[0, 2]]).all() and distances[1] < 0
+
+
+def test_facing_defaults_and_ties_are_deterministic():
+    assert choose_facing((0.0, 0.0), 0.0, (1.0, 1.0, 1.0), []) == 0
+    walls = [((-0.7, -3.0), (-0.7, 3.0)), ((0.7, -3.0), (0.7, 3.0))]  # equally near on -x and +x
+    assert choose_facing((0.0, 0.0), 0.0, (1.0, 1.0, 1.0), walls) == choose_facing((0.0, 0.0), 0.0, (1.0, 1.0, 1.0),
+                                                                                 walls[::-1]) == 2
+
+
+def test_facing_distance_is_measured_from_the_box_side():
+    walls = [((2.0, -1.0), (2.0, 1.0))]
+    assert side_distances((0.0, 0.0), 0.0, (1.0, 0.5, 1.0), walls)[0] == pytest.approx(1.5)
+    assert side_distances((0.0, 0.0), np.pi / 2, (1.0, 0.5, 1.0), walls)[3] == pytest.approx(1.75)
