@@ -95,7 +95,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
         if args.path:
             x0, y0, x1, y1 = args.path
             closed = [d for d, is_open in resolved.doors.items() if not is_open]
-            path = plan_path(free, (x0, y0), (x1, y1), blocked_by=closed).points
+            path = plan_path(free, (x0, y0), (x1, y1), house=house, blocked_by=closed).points
     image = draw_plan(house, door_open=resolved.doors, models=resolved.models,
                       free_space=free if args.free_space else None, path=path)
     write_plan(args.output, image)

@@ -8,12 +8,14 @@ and the node read the world through this class; nothing else talks to this pybul
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import math
 import os
 import pkgutil
 import sys
 from pathlib import Path
+from typing import Iterator
 
 import cv2
 import numpy as np
@@ -72,7 +74,8 @@ class World:
     # ------------------------------------------------------------------ life cycle
     def close(self) -> None:
         if self.client >= 0:
-            pb.disconnect(self.client)
+            with _quiet_stdout():
+                pb.disconnect(self.client)
             self.client = -1
 
     def __enter__(self) -> World:
@@ -87,7 +90,9 @@ class World:
         loader = pkgutil.get_loader("eglRenderer")
         plugin = -1
         if loader is not None:
-            plugin = pb.loadPlugin(loader.get_filename(), "_eglRendererPlugin", physicsClientId=self.client)
+            with _quiet_stdout():
+                plugin = pb.loadPlugin(loader.get_filename(), "_eglRendererPlugin",
+                                       physicsClientId=self.client)
         if plugin < 0:
             print("ravh_sim: EGL rendering unavailable, falling back to TinyRenderer (slower)",
                   file=sys.stderr)
@@ -276,6 +281,21 @@ class World:
         pos, orn = pb.getBasePositionAndOrientation(self._by_name[name].body, physicsClientId=self.client)
         return tuple(pos), tuple(orn)
 
+
+
+@contextlib.contextmanager
+def _quiet_stdout() -> Iterator[None]:
+    """Silence C-level stdout (the EGL plugin prints its GL banner there), so CLI output stays clean."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(devnull)
 
 
 def mesh_bytes(mesh) -> bytes:

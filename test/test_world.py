@@ -1,0 +1,84 @@
+"""The pybullet World: every house builds, every labelled object is its own body, run-time changes work."""
+from __future__ import annotations
+
+import math
+
+import pybullet as pb
+import pytest
+
+from conftest import resolved
+from ravh_sim.world.footprint import build_instances
+from ravh_sim.world.scene import World
+
+
+def test_every_house_builds_with_one_body_per_labelled_object(houses):
+    for n, house in houses.items():
+        with World(house, resolved(house), renderer="tiny") as world:
+            objects = [i for i in world.instances if i.kind in ("object", "door", "window")]
+            assert len(objects) == len(house.objects), n
+            bodies = [i.body for i in world.instances]
+            assert len(set(bodies)) == len(bodies) and min(bodies) >= 0, n
+            assert pb.getNumBodies(physicsClientId=world.client) == len(bodies) + 1, n   # + the ground
+            lut = world.body_to_instance_lut()
+            assert all(lut[i.body] == i.id for i in world.instances), n
+
+
+def test_house_23_geometry_budget(houses):
+    with World(houses[23], resolved(houses[23]), renderer="tiny") as world:
+        assert 0 < world.triangle_count < 60_000
+
+
+def test_instances_match_the_pure_instance_table(houses):
+    with World(houses[15], resolved(houses[15]), renderer="tiny") as world:
+        assert [(i.id, i.name, i.mask_color) for i in world.instances] == \
+               [(i.id, i.name, i.mask_color) for i in build_instances(houses[15])]
+
+
+def test_collision_boxes_fit_the_object_boxes(houses):
+    house = houses[20]
+    settings = resolved(house)
+    with World(house, settings, renderer="tiny") as world:
+        for obj in house.objects:
+            if obj.type in ("Door", "Station"):
+                continue
+            box = obj.box(settings.models[obj.id])
+            lo, hi = pb.getAABB(world.instance(obj.id).body, physicsClientId=world.client)
+            assert (lo[2] + hi[2]) / 2 == pytest.approx(box.position[2], abs=0.02), obj.id
+            assert hi[2] - lo[2] == pytest.approx(box.size[2], abs=0.02), obj.id
+
+
+def test_doors_open_and_close_at_run_time(houses):
+    house = houses[15]
+    with World(house, resolved(house), renderer="tiny") as world:
+        door = house.doors[0]
+        world.set_door_open(door.id, False)
+        closed_z = world.object_pose(door.id)[0][2]
+        nx, ny = -math.sin(door.yaw), math.cos(door.yaw)          # across the doorway
+        x, y = door.position[:2]
+
+        def ray_hit() -> int:
+            return pb.rayTest([x - 0.6 * nx, y - 0.6 * ny, 1.0], [x + 0.6 * nx, y + 0.6 * ny, 1.0],
+                              physicsClientId=world.client)[0][0]
+
+        assert ray_hit() == world.instance(door.id).body
+        world.set_door_open(door.id, True)
+        assert ray_hit() == -1
+        assert world.object_pose(door.id)[0][2] < closed_z - 10
+        assert world.settings.doors[door.id] is True
+
+
+def test_model_swap_rebuilds_the_body(houses):
+    house = houses[15]
+    settings = resolved(house)
+    with World(house, settings, renderer="tiny") as world:
+        inst = world.instance("Bed_0")
+        before = pb.getVisualShapeData(inst.body, physicsClientId=world.client)[0][4]
+        world.set_object_model("Bed_0", (settings.models["Bed_0"] + 1) % 3)
+        after = pb.getVisualShapeData(world.instance("Bed_0").body, physicsClientId=world.client)[0][4]
+        assert before != after
+        assert world.body_to_instance_lut()[world.instance("Bed_0").body] == inst.id
+
+
+def test_egl_or_fallback_renderer_is_reported(houses):
+    with World(houses[20], resolved(houses[20])) as world:
+        assert world.renderer in ("egl", "tiny")
