@@ -7,8 +7,8 @@ import cv2
 import numpy as np
 import pytest
 
-from ravh_sim.world.facing import choose_facing, side_distances
-from ravh_sim.world.furniture import OBJECT_TYPES, build_model, variant_count
+from ravh_sim.world.facing import choose_facing, side_distances, suits_box
+from ravh_sim.world.furniture import OBJECT_TYPES, build_model, front_axis, variant_count
 from ravh_sim.world.mesh import Mesh, box, cylinder, ellipsoid, frustum, rotation_y, rotation_z, rounded_box
 from ravh_sim.world.palette import PALETTE, Palette
 
@@ -38,8 +38,8 @@ TYPICAL = {
 PREFABS = {
     'KitchenFurniture': ['', '1 Door', '2Door', '3 Door', '1 Door Up', '2 Door Up', '3 Door Up', 'Corner',
                          'Corner Up', 'Sink/Body', 'Sink2/Body', 'Burner and Oven'],
-    'Standard': ['rack_1', 'Tv Table'], 'Sofa': ['Small Sofa', 'Corner Sofa'], 'Chair': ['Chair', 'Chair_office'],
-    'Bathtub': ['Bathtub', 'Bathtub 2'],
+    'Standard': ['rack_1', 'Tv Table'], 'Sofa': ['Small Sofa', 'Corner Sofa'],
+    'Chair': ['Chair', 'Chair_office'], 'Bathtub': ['Bathtub', 'Bathtub 2'],
 }
 
 ALL_TYPES = list(OBJECT_TYPES) + ['SomethingUnknown']
@@ -71,8 +71,8 @@ def check_model(mesh: Mesh, size: tuple[float, float, float]) -> None:
 @pytest.mark.parametrize('object_type', ALL_TYPES)
 def test_models_fit_their_box_for_every_variant_size_and_facing(object_type):
     for prefab in PREFABS.get(object_type, ['']):
-        for variant, size, facing in itertools.product(range(variant_count(object_type)), sizes_for(object_type),
-                                                       range(4)):
+        variants = range(variant_count(object_type))
+        for variant, size, facing in itertools.product(variants, sizes_for(object_type), range(4)):
             mesh = build_model(object_type, size, variant, facing, prefab)
             check_model(mesh, size)
             assert mesh.triangle_count <= 500
@@ -86,7 +86,8 @@ def test_typical_models_stay_within_triangle_budget(object_type):
 
 
 def test_average_model_is_cheap():
-    counts = [build_model(t, typical(t), v).triangle_count for t in OBJECT_TYPES for v in range(variant_count(t))]
+    counts = [build_model(t, typical(t), v).triangle_count
+              for t in OBJECT_TYPES for v in range(variant_count(t))]
     assert np.mean(counts) <= 250
 
 
@@ -106,9 +107,10 @@ def same_mesh(a: Mesh, b: Mesh) -> bool:
 @pytest.mark.parametrize('object_type', [t for t in OBJECT_TYPES if variant_count(t) > 1])
 def test_variants_differ(object_type):
     for prefab in PREFABS.get(object_type, ['']):
-        meshes = [build_model(object_type, typical(object_type), v, 0, prefab) for v in range(variant_count(object_type))]
+        meshes = [build_model(object_type, typical(object_type), v, 0, prefab)
+                  for v in range(variant_count(object_type))]
         for a, b in itertools.combinations(range(len(meshes)), 2):
-            assert not same_mesh(meshes[a], meshes[b]), f'{object_type} {prefab!r} variants {a} and {b} look the same'
+            assert not same_mesh(meshes[a], meshes[b]), f'{object_type} {prefab!r}: {a} and {b} look alike'
 
 
 def test_variant_index_wraps_and_facing_wraps():
@@ -169,8 +171,28 @@ def test_tv_screen_looks_along_its_facing(facing):
     direction = FACING_DIRECTIONS[facing]
     cross = mesh.face_cross()[screen]
     normal = cross[np.argmax(np.linalg.norm(cross, axis=1))]
-    assert abs(np.dot(normal[:2], direction)) / np.linalg.norm(normal) > 0.99  # the panel is across the facing
+    assert abs(np.dot(normal[:2], direction)) / np.linalg.norm(normal) > 0.99  # the panel faces that way
     assert np.dot(centroid_of(mesh, screen)[:2] - centroid_of(mesh, bezel)[:2], direction) > 0  # and in front
+
+
+@pytest.mark.parametrize('object_type', OBJECT_TYPES)
+def test_unsuitable_facings_turn_a_quarter(object_type):
+    size = (2.0, 0.5, 1.0)
+    for facing in range(4):
+        mesh = build_model(object_type, size, 0, facing)
+        if suits_box(front_axis(object_type), size, facing):
+            assert not same_mesh(mesh, build_model(object_type, size, 0, (facing + 1) % 4))
+        else:
+            assert same_mesh(mesh, build_model(object_type, size, 0, (facing + 1) % 4))
+
+
+def test_front_axes_of_typical_furniture():
+    assert front_axis('Bed') == front_axis('Toilet') == 'long'
+    assert front_axis('Closet') == front_axis('Picture') == front_axis('Sofa') == 'short'
+    assert front_axis('Chair') == front_axis('SomethingUnknown') == 'any'
+    assert suits_box('short', (2.0, 0.6, 1.0), 1) and not suits_box('short', (2.0, 0.6, 1.0), 0)
+    assert suits_box('long', (2.0, 0.6, 1.0), 2) and not suits_box('long', (2.0, 0.6, 1.0), 3)
+    assert all(suits_box(front, (1.0, 1.05, 1.0), f) for front in ('short', 'long', 'any') for f in range(4))
 
 
 def test_flat_wall_items_face_across_their_thin_axis():
@@ -208,12 +230,17 @@ def test_primitives_are_closed_outward_and_centred(name):
     assert mesh.face_areas().min() > 0 and (mesh.colours == 3).all()
 
 
+def extent(mesh: Mesh) -> np.ndarray:
+    lo, hi = mesh.bounds()
+    return hi - lo
+
+
 def test_primitive_extents_and_triangle_counts():
-    assert np.allclose(np.subtract(*box((0, 0, 0), (0.4, 0.6, 0.8), 0).bounds()[::-1]), (0.4, 0.6, 0.8))
-    assert np.allclose(np.subtract(*cylinder((0, 0, 0), 0.3, 0.8, 0).bounds()[::-1]), (0.6, 0.6, 0.8))
-    assert np.allclose(np.subtract(*cylinder((0, 0, 0), 0.3, 0.8, 0, axis='x').bounds()[::-1]), (0.8, 0.6, 0.6))
-    assert np.allclose(np.subtract(*rounded_box((0, 0, 0), (0.4, 0.6, 0.8), 0, 0.1).bounds()[::-1]), (0.4, 0.6, 0.8))
-    assert np.allclose(np.subtract(*ellipsoid((0, 0, 0), (0.4, 0.6, 0.8), 0).bounds()[::-1]), (0.4, 0.6, 0.8))
+    assert np.allclose(extent(box((0, 0, 0), (0.4, 0.6, 0.8), 0)), (0.4, 0.6, 0.8))
+    assert np.allclose(extent(cylinder((0, 0, 0), 0.3, 0.8, 0)), (0.6, 0.6, 0.8))
+    assert np.allclose(extent(cylinder((0, 0, 0), 0.3, 0.8, 0, axis='x')), (0.8, 0.6, 0.6))
+    assert np.allclose(extent(rounded_box((0, 0, 0), (0.4, 0.6, 0.8), 0, 0.1)), (0.4, 0.6, 0.8))
+    assert np.allclose(extent(ellipsoid((0, 0, 0), (0.4, 0.6, 0.8), 0)), (0.4, 0.6, 0.8))
     assert box((0, 0, 0), (1, 1, 1), 0).triangle_count == 12
     assert cylinder((0, 0, 0), 1, 1, 0, segments=10).triangle_count == 36
     assert rounded_box((0, 0, 0), (1, 1, 1), 0, 0.1).triangle_count == 44
@@ -231,7 +258,7 @@ def test_transform_rotates_translates_and_keeps_winding_under_mirroring():
     mesh = box((1.0, 0.0, 0.0), (0.2, 0.4, 0.6), 0)
     turned = mesh.transformed(np.pi / 2, (0.0, 0.0, 1.0))
     assert np.allclose(turned.vertices.mean(axis=0), (0.0, 1.0, 1.0))
-    assert np.allclose(np.subtract(*turned.bounds()[::-1]), (0.4, 0.2, 0.6))
+    assert np.allclose(extent(turned), (0.4, 0.2, 0.6))
     mirrored = mesh.transformed(np.diag([-1.0, 1.0, 1.0]))
     assert mirrored.signed_volume() == pytest.approx(mesh.signed_volume())
     assert np.allclose(rotation_z(np.pi / 2) @ (1, 0, 0), (0, 1, 0))
@@ -287,7 +314,8 @@ def test_palette_uv_samples_its_colour_from_the_written_texture(tmp_path):
         expected = np.round(PALETTE.rgb[i] * 255)[::-1]  # BGR on disk
         for row in (int((1.0 - v) * height), int(v * height)):  # either image row order
             for du in (-3, 0, 3):  # and a few texels around the centre, as filtering would
-                assert np.array_equal(image[min(row, height - 1), int(u * width) + du], expected), PALETTE.names[i]
+                texel = image[min(row, height - 1), int(u * width) + du]
+                assert np.array_equal(texel, expected), PALETTE.names[i]
 
 
 def test_palette_rejects_too_many_colours():
@@ -310,8 +338,19 @@ def wall_beside(center: np.ndarray, yaw: float, side: int, gap: float, size: tup
 @pytest.mark.parametrize('back_side', range(4))
 def test_front_points_away_from_the_nearest_wall(yaw, back_side):
     center, size = np.array([1.0, -2.0]), (0.8, 0.5, 1.0)
-    walls = [wall_beside(center, yaw, back_side, 0.05, size), wall_beside(center, yaw, (back_side + 1) % 4, 0.6, size)]
+    walls = [wall_beside(center, yaw, back_side, 0.05, size),
+             wall_beside(center, yaw, (back_side + 1) % 4, 0.6, size)]
     assert choose_facing(center, yaw, size, walls) == (back_side + 2) % 4
+
+
+@pytest.mark.parametrize('yaw', [0.0, 0.4, -np.pi / 2])
+def test_front_axis_keeps_corner_furniture_backed_onto_the_right_wall(yaw):
+    center, size = np.array([0.5, 0.5]), (2.0, 0.6, 2.0)  # a wardrobe, long along local x
+    walls = [wall_beside(center, yaw, 0, 0.02, size), wall_beside(center, yaw, 1, 0.05, size)]
+    assert choose_facing(center, yaw, size, walls) == 2  # nearest wall is at the +x end
+    assert choose_facing(center, yaw, size, walls, front='short') == 3  # but doors face away from +y
+    assert choose_facing(center, yaw, size, walls, front='long') == 2
+    assert choose_facing(center, yaw, size, [], front='short') == 1
 
 
 def test_facing_ignores_walls_beside_the_sweep_and_parallel_to_it():
@@ -326,8 +365,9 @@ def test_facing_ignores_walls_beside_the_sweep_and_parallel_to_it():
 def test_facing_defaults_and_ties_are_deterministic():
     assert choose_facing((0.0, 0.0), 0.0, (1.0, 1.0, 1.0), []) == 0
     walls = [((-0.7, -3.0), (-0.7, 3.0)), ((0.7, -3.0), (0.7, 3.0))]  # equally near on -x and +x
-    assert choose_facing((0.0, 0.0), 0.0, (1.0, 1.0, 1.0), walls) == choose_facing((0.0, 0.0), 0.0, (1.0, 1.0, 1.0),
-                                                                                 walls[::-1]) == 2
+    size = (1.0, 1.0, 1.0)
+    assert choose_facing((0.0, 0.0), 0.0, size, walls) == 2
+    assert choose_facing((0.0, 0.0), 0.0, size, walls[::-1]) == 2
 
 
 def test_facing_distance_is_measured_from_the_box_side():

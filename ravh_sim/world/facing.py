@@ -23,21 +23,44 @@ PARALLEL_COS = np.cos(np.radians(30.0))
 TIE_DECIMALS = 6
 """Distances are compared at micrometre resolution so ties break by index, not by noise."""
 
+SWAP_RATIO = 1.15
+"""How much longer than the other a box axis must be before 'short'/'long' fronts care."""
+
+
+def suits_box(front: str, size: Sequence[float], facing: int) -> bool:
+    """Whether ``facing`` suits a type whose front belongs on a given side of its box.
+
+    ``front`` is 'short' (the front looks across the box's short horizontal
+    axis: wardrobes, sofas, pictures), 'long' (along the long axis: beds,
+    toilets) or 'any'.  Nearly square boxes suit every facing.
+    """
+    depth, width = (abs(size[0]), abs(size[1])) if facing % 2 == 0 else (abs(size[1]), abs(size[0]))
+    if front == 'short':
+        return depth <= SWAP_RATIO * width
+    if front == 'long':
+        return width <= SWAP_RATIO * depth
+    return True
+
 
 def choose_facing(center_xy: Sequence[float], yaw: float, size: Sequence[float],
-                  wall_segments: Sequence[Segment]) -> int:
+                  wall_segments: Sequence[Segment], front: str = 'any') -> int:
     """Facing index whose front points away from the nearest wall.
 
     For each of the box's four sides, sweep the side outwards along its
     normal and measure how far it travels before touching a wall segment;
-    the side with the shortest distance is the back.  Ties go to the lowest
-    side index; with no wall in reach the facing is 0.
+    the side with the shortest distance is the back.  ``front`` (see
+    ``suits_box``) limits the choice to facings that suit the type, so a
+    wardrobe in a corner backs onto the wall behind its long side even when
+    the wall at its end is nearer.  Ties go to the lowest index; with no
+    wall in reach the facing is the lowest suitable one.
     """
+    suitable = [f for f in range(4) if suits_box(front, size, f)]  # never empty
     distances = side_distances(center_xy, yaw, size, wall_segments)
-    if not np.isfinite(distances).any():
-        return 0
-    back = int(np.argmin(np.round(distances, TIE_DECIMALS)))
-    return (back + 2) % 4
+    backs = [(f + 2) % 4 for f in suitable]
+    if not np.isfinite(distances[backs]).any():
+        return suitable[0]
+    rounded = np.round(distances, TIE_DECIMALS)
+    return min(suitable, key=lambda f: (rounded[(f + 2) % 4], (f + 2) % 4))
 
 
 def side_distances(center_xy: Sequence[float], yaw: float, size: Sequence[float],

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ravh_sim.world.facing import suits_box
 from ravh_sim.world.mesh import Mesh, box, ellipsoid, frustum, rotation_y, rounded_box
 from ravh_sim.world.palette import PALETTE
 
@@ -31,10 +32,6 @@ Builder = Callable[[float, float, float, int, str], Parts]
 
 MIN_EXTENT = 1e-3
 """Smallest box extent built (m); zero, negative or non-finite extents are raised to it."""
-
-SWAP_RATIO = 1.15
-"""A type whose front belongs on the short (or long) side turns a quarter when the
-requested facing contradicts the box shape by more than this ratio."""
 
 _TINY = 1e-6
 """Smallest part extent (m), so no part collapses into zero-area triangles."""
@@ -132,7 +129,8 @@ def _frame(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float, f: 
            colour: str, bottom: str = '') -> Parts:
     """Rectangular picture-style frame of bar width f in the plane x = const."""
     return [_blk(x0, x1, y0, y1, z0, z0 + f, bottom or colour), _blk(x0, x1, y0, y1, z1 - f, z1, colour),
-            _blk(x0, x1, y0, y0 + f, z0 + f, z1 - f, colour), _blk(x0, x1, y1 - f, y1, z0 + f, z1 - f, colour)]
+            _blk(x0, x1, y0, y0 + f, z0 + f, z1 - f, colour),
+            _blk(x0, x1, y1 - f, y1, z0 + f, z1 - f, colour)]
 
 
 # --- fronts: doors, drawers, handles ---------------------------------------------------------
@@ -193,7 +191,8 @@ def _fronts(x: float, d: float, fronts: Sequence[_Front], finish: _Finish) -> Pa
     parts = []
     for f in fronts:
         gap = min(0.003, 0.04 * (f.y1 - f.y0), 0.04 * (f.z1 - f.z0))
-        parts.append(_blk(x, x + ft, f.y0 + gap, f.y1 - gap, f.z0 + gap, f.z1 - gap, f.colour or finish.panel))
+        colour = f.colour or finish.panel
+        parts.append(_blk(x, x + ft, f.y0 + gap, f.y1 - gap, f.z0 + gap, f.z1 - gap, colour))
         parts += _pull(x + ft, min(x + ft + hd, d), f, finish)
     return parts
 
@@ -223,7 +222,8 @@ def _open_shelves(xf: float, d: float, w: float, z0: float, z1: float, colour: s
     levels = np.linspace(z0 + t / 2, z1 - t / 2, _count(z1 - z0, 0.35, 1, 5) + 1)
     parts = [_blk(xf, xf + 0.05 * ft, -w / 2, w / 2, z0, z1, 'charcoal')]
     parts += [_blk(xf, xf + ft, -w / 2, w / 2, z - t / 2, z + t / 2, colour) for z in levels]
-    parts += [_blk(xf, xf + ft, y - t / 2, y + t / 2, z0, z1, colour) for y in (-w / 2 + t / 2, w / 2 - t / 2)]
+    parts += [_blk(xf, xf + ft, y - t / 2, y + t / 2, z0, z1, colour)
+              for y in (-w / 2 + t / 2, w / 2 - t / 2)]
     if books:
         openings = [(a + t / 2, b - t / 2) for a, b in zip(levels[:-1], levels[1:])]
         parts += _books(xf, xf + 0.8 * ft, -w / 2 + t, w / 2 - t, openings)
@@ -272,14 +272,15 @@ def _chair_back(bt: float, w: float, h: float, seat_z: float, t: float, frame: s
     if style == 'shell':
         return [_soft(0.0, bt, -w / 2, w / 2, seat_z, h, seat, 0.3 * bt)]
     post_top = h if style in ('slats', 'ladder') else seat_z + 0.25 * rise
-    posts = [_blk(0.0, t, y - t / 2, y + t / 2, seat_z, post_top, frame) for y in (-w / 2 + t / 2, w / 2 - t / 2)]
+    posts = [_blk(0.0, t, y - t / 2, y + t / 2, seat_z, post_top, frame)
+             for y in (-w / 2 + t / 2, w / 2 - t / 2)]
     if style == 'panel':
         return posts + [_soft(0.0, bt, -w / 2, w / 2, seat_z + 0.12 * rise, h, seat, 0.3 * bt)]
     rail = min(0.07, 0.15 * rise)
     parts = posts + [_blk(0.0, bt, -w / 2 + t, w / 2 - t, h - rail, h, frame)]
     if style == 'slats':
-        return parts + [_blk(0.2 * bt, 0.8 * bt, a + 0.3 * (b - a), b - 0.3 * (b - a), seat_z, h - rail, frame)
-                        for a, b in _split(-w / 2 + t, w / 2 - t, 3)]
+        return parts + [_blk(0.2 * bt, 0.8 * bt, a + 0.3 * (b - a), b - 0.3 * (b - a), seat_z, h - rail,
+                             frame) for a, b in _split(-w / 2 + t, w / 2 - t, 3)]
     return parts + [_blk(0.1 * bt, 0.9 * bt, -w / 2 + t, w / 2 - t, z - rail / 3, z + rail / 3, frame)
                     for z in (seat_z + 0.3 * rise, h - 1.8 * rail)]
 
@@ -339,15 +340,16 @@ def _upholstered(d: float, w: float, h: float, s: _Upholstery, seats: int, chais
     seat_y1 = w / 2 - aw - (min(_CHAISE_WIDTH, 0.45 * w) if chaise else 0.0)
     parts = [_blk(0.0, d, -w / 2, w / 2, lh, base_top, s.fabric),
              _blk(0.0, bd, -w / 2 + aw, w / 2 - aw, base_top, h, s.fabric)]
+    bevel = 0.25 * (seat_top - base_top)
     for a, b in _split(-w / 2 + aw, seat_y1, seats):
-        parts += [_soft(bd, d, a, b, base_top, seat_top, cushion, 0.25 * (seat_top - base_top)),
+        parts += [_soft(bd, d, a, b, base_top, seat_top, cushion, bevel),
                   _blk(bd, 1.5 * bd, a + 0.01 * w, b - 0.01 * w, seat_top, 0.95 * h, cushion)]
     if chaise:
         parts += [_blk(0.0, chaise, seat_y1, w / 2, lh, base_top, s.fabric),
-                  _soft(bd, chaise, seat_y1, w / 2 - aw, base_top, seat_top, cushion, 0.25 * (seat_top - base_top)),
+                  _soft(bd, chaise, seat_y1, w / 2 - aw, base_top, seat_top, cushion, bevel),
                   _blk(bd, 1.5 * bd, seat_y1, w / 2 - aw, seat_top, 0.95 * h, cushion)]
-    parts += _sofa_arm(-w / 2, -w / 2 + aw, lh, arm_top, d, s) + _sofa_arm(w / 2 - aw, w / 2, lh, arm_top,
-                                                                         chaise or d, s)
+    parts += _sofa_arm(-w / 2, -w / 2 + aw, lh, arm_top, d, s)
+    parts += _sofa_arm(w / 2 - aw, w / 2, lh, arm_top, chaise or d, s)
     if s.legs:
         t = min(0.05, 0.08 * min(d, w))
         parts += _legs(0.0, d, -w / 2, w / 2, 0.0, lh, t, s.legs)
@@ -374,8 +376,8 @@ def _stool(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
         t = min(0.025, 0.1 * min(d, w))
         rails = [_blk(0.1 * d, 0.9 * d, y - t / 3, y + t / 3, 0.3 * h, 0.3 * h + t / 1.5, 'chrome')
                  for y in (-0.42 * w + t / 2, 0.42 * w - t / 2)]
-        return _legs(0.08 * d, 0.92 * d, -0.42 * w, 0.42 * w, 0.0, 0.93 * h, t, 'chrome', round_=True) + rails + [
-            _disc(rx, 0.0, 0.93 * h, h, rx, ry, 'leather_black', 12)]
+        legs = _legs(0.08 * d, 0.92 * d, -0.42 * w, 0.42 * w, 0.0, 0.93 * h, t, 'chrome', round_=True)
+        return legs + rails + [_disc(rx, 0.0, 0.93 * h, h, rx, ry, 'leather_black', 12)]
     if style == 1:  # wooden square stool with stretchers
         t = min(0.04, 0.14 * min(d, w))
         stretchers = [_blk(t / 2, d - t / 2, y - t / 3, y + t / 3, 0.25 * h, 0.25 * h + t, 'wood_light')
@@ -452,7 +454,7 @@ def _headboard(hb: float, w: float, h: float, frame: str, style: str) -> Parts:
     if style == 'posts':
         return posts + [_blk(0.15 * hb, 0.85 * hb, -w / 2 + hb, w / 2 - hb, 0.3 * h, 0.92 * h, frame)]
     bars = [_blk(0.35 * hb, 0.65 * hb, y - 0.15 * hb, y + 0.15 * hb, 0.3 * h, 0.9 * h, frame)
-            for y in np.linspace(-w / 2 + hb, w / 2 - hb, _count(w, 0.2, 4, 8) + 2)[1:-1]]
+            for y in np.linspace(-w / 2 + hb, w / 2 - hb, _count(w, 0.25, 4, 8) + 2)[1:-1]]
     rails = [_blk(0.25 * hb, 0.75 * hb, -w / 2, w / 2, z - 0.25 * hb, z + 0.25 * hb, frame)
              for z in (0.3 * h, 0.9 * h)]
     return posts + bars + rails
@@ -513,7 +515,8 @@ def _desk(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     drawers = _drawer_grid(min(inner, outer), max(inner, outer), 0.02 * h, under, 3 if side > 0 else 2, 1)
     panel_y = -side * (w / 2 - t / 2)
     return parts + [carcass, _blk(0.0, d, panel_y - t / 2, panel_y + t / 2, 0.0, under, finish.body),
-                    _blk(0.0, t, -w / 2, w / 2, 0.35 * h, under, finish.body)] + _fronts(xf, d, drawers, finish)
+                    _blk(0.0, t, -w / 2, w / 2, 0.35 * h, under, finish.body)] + _fronts(
+        xf, d, drawers, finish)
 
 
 # --- storage ------------------------------------------------------------------------------
@@ -545,7 +548,8 @@ def _cabinet(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     return parts + _open_shelves(xf, d, w, split, h, finish.body) + _fronts(xf, d, lower, finish)
 
 
-_CLOSETS = (_Finish('white', 'white', 'chrome', 'long'), _Finish('wood_medium', 'wood_medium', 'brass', 'knob'),
+_CLOSETS = (_Finish('white', 'white', 'chrome', 'long'),
+            _Finish('wood_medium', 'wood_medium', 'brass', 'knob'),
             _Finish('wood_light', 'wood_light', 'metal', 'long'), _Finish('wood_dark', 'wood_dark', 'brass'))
 
 
@@ -581,8 +585,8 @@ def _dresser(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     carcass, xf = _carcass(d, -w / 2, w / 2, fh, h - tt, finish.body)
     cols = 2 if w > 0.8 else 1
     small = h - tt - (h - tt - fh) / (rows + 1)
-    fronts = _drawer_grid(-w / 2, w / 2, fh, small, rows - 1, cols) + _drawer_grid(-w / 2, w / 2, small, h - tt,
-                                                                                   1, cols + 1)
+    fronts = (_drawer_grid(-w / 2, w / 2, fh, small, rows - 1, cols)
+              + _drawer_grid(-w / 2, w / 2, small, h - tt, 1, cols + 1))
     return [carcass, _blk(0.0, d, -w / 2, w / 2, h - tt, h, finish.body)] + _feet(
         d, w, fh, finish.body, feet) + _fronts(xf, d, fronts, finish)
 
@@ -592,7 +596,8 @@ def _feet(d: float, w: float, fh: float, colour: str, kind: str) -> Parts:
         return [_plinth(d, w, fh, colour)]
     t = min(0.05, 0.12 * min(d, w))
     if kind == 'buns':
-        return [_post(x, y, 0.0, fh, t / 2, colour) for x in (t / 2, d - t / 2) for y in (-w / 2 + t / 2, w / 2 - t / 2)]
+        return [_post(x, y, 0.0, fh, t / 2, colour)
+                for x in (t / 2, d - t / 2) for y in (-w / 2 + t / 2, w / 2 - t / 2)]
     return _legs(0.0, d, -w / 2, w / 2, 0.0, fh, t, colour)
 
 
@@ -607,7 +612,8 @@ def _nightstand(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     style = v % 3
     fh, tt = min(0.12 if style == 0 else 0.05, 0.2 * h), min(0.025, 0.06 * h)
     carcass, xf = _carcass(d, -w / 2, w / 2, fh, h - tt, finish.body)
-    parts = [carcass, _blk(0.0, d, -w / 2, w / 2, h - tt, h, finish.body)] + _feet(d, w, fh, finish.body, feet)
+    parts = [carcass, _blk(0.0, d, -w / 2, w / 2, h - tt, h, finish.body)]
+    parts += _feet(d, w, fh, finish.body, feet)
     if style == 0:
         split = fh + 0.55 * (h - tt - fh)
         return parts + _open_shelves(xf, d, w, fh, split, finish.body, books=False) + _fronts(
@@ -643,7 +649,8 @@ def _standard(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     openings = [(float(a + t), float(b)) for a, b in zip(levels[:-1], levels[1:])]
     parts = [_blk(0.0, d, y - t / 2, y + t / 2, 0.0, h, colour) for y in (-w / 2 + t / 2, w / 2 - t / 2)]
     parts += [_blk(0.0, d, -w / 2 + t, w / 2 - t, z, z + t, colour) for z in levels]
-    parts.append(_blk(0.0, 0.02 * d, -w / 2 + t, w / 2 - t, 0.0, h, 'grey_light' if style == 1 else 'charcoal'))
+    back = 'grey_light' if style == 1 else 'charcoal'
+    parts.append(_blk(0.0, 0.02 * d, -w / 2 + t, w / 2 - t, 0.0, h, back))
     if style == 1:
         return parts + _cubbies(d, w, h, t, colour, openings)
     if style == 3:
@@ -662,7 +669,8 @@ def _cubbies(d: float, w: float, h: float, t: float, colour: str,
     for i, (z0, z1) in enumerate(openings):
         for j, (a, b) in enumerate(columns):
             if (i + j) % 3 != 2:  # leave some cubbies open
-                parts.append(_blk(0.3 * d, d, a + 0.08 * (b - a), b - 0.08 * (b - a), z0, z0 + 0.8 * (z1 - z0),
+                margin = 0.08 * (b - a)
+                parts.append(_blk(0.3 * d, d, a + margin, b - margin, z0, z0 + 0.8 * (z1 - z0),
                                   _pick(_BOOK_COLOURS, i + j)))
     return parts
 
@@ -691,8 +699,9 @@ def _tv_unit(d: float, w: float, h: float, v: int) -> Parts:
     carcass, xf = _carcass(d, -w / 2, w / 2, fh, h, finish.body)
     side = min(0.4, 0.35 * w)
     fronts = [_Front(-w / 2, -w / 2 + side, fh, h, 'drawer'), _Front(w / 2 - side, w / 2, fh, h, 'drawer')]
-    return [carcass] + _legs(0.05 * d, 0.95 * d, -0.48 * w, 0.48 * w, 0.0, fh, min(0.04, 0.1 * d), 'black') + (
-        _open_shelves(xf, d, w - 2 * side, fh, h, finish.body, books=False)) + _fronts(xf, d, fronts, finish)
+    legs = _legs(0.05 * d, 0.95 * d, -0.48 * w, 0.48 * w, 0.0, fh, min(0.04, 0.1 * d), 'black')
+    bay = _open_shelves(xf, d, w - 2 * side, fh, h, finish.body, books=False)
+    return [carcass] + legs + bay + _fronts(xf, d, fronts, finish)
 
 
 # --- kitchen --------------------------------------------------------------------------------
@@ -723,8 +732,8 @@ def _kitchen(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
             xf, d, w, drawer, h, 'black')
     if 'sink' in name:
         top = h - 0.18 * (h - ph)
-        fronts = [_Front(-w / 2, w / 2, top, h, 'drawer')] + _door_row(-w / 2, w / 2, ph, top,
-                                                                      _count(w, 0.5, 1, 2), 'top')
+        doors = _door_row(-w / 2, w / 2, ph, top, _count(w, 0.5, 1, 2), 'top')
+        fronts = [_Front(-w / 2, w / 2, top, h, 'drawer')] + doors
         return parts + _fronts(xf, d, fronts, finish)
     height = 'bottom' if wall else 'top'
     if 'corner' in name:  # a blind panel where the neighbouring run butts in
@@ -761,7 +770,8 @@ def _burner(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     r = 0.2 * min(d, w)
     for x in (0.28 * d, 0.72 * d):
         for y in (-0.23 * w, 0.23 * w):
-            parts += [_disc(x, y, 0.0, 0.8 * h, r, r, 'grey_dark', 8), _disc(x, y, 0.0, h, r / 2, r / 2, 'charcoal', 8)]
+            parts += [_disc(x, y, 0.0, 0.8 * h, r, r, 'grey_dark', 8),
+                      _disc(x, y, 0.0, h, r / 2, r / 2, 'charcoal', 8)]
     return parts
 
 
@@ -811,14 +821,15 @@ def _microwave(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     ft, hd = _front_depths(d)
     xf = d - ft - hd
     panel = 0.28 * w
-    buttons = [_blk(xf + ft, xf + ft + 0.3 * hd, y - 0.06 * panel, y + 0.06 * panel, z - 0.03 * h, z + 0.03 * h,
-                    'grey') for z in (0.25 * h, 0.42 * h, 0.6 * h) for y in (w / 2 - 0.35 * panel, w / 2 - 0.65 * panel)]
+    button = 0.06 * panel
+    buttons = [_blk(xf + ft, xf + ft + 0.3 * hd, y - button, y + button, z - 0.03 * h, z + 0.03 * h, 'grey')
+               for z in (0.25 * h, 0.42 * h, 0.6 * h) for y in (w / 2 - 0.35 * panel, w / 2 - 0.65 * panel)]
     door = _Front(-0.48 * w, w / 2 - panel, 0.05 * h, 0.95 * h, 'right')
     return [_soft(0.0, xf, -w / 2, w / 2, 0.0, h, 'steel', 0.04 * min(d, h)),
             _blk(xf + ft, xf + 1.1 * ft, -0.42 * w, w / 2 - panel - 0.08 * w, 0.2 * h, 0.8 * h, 'glass_dark'),
             _blk(xf, xf + ft, w / 2 - panel, 0.48 * w, 0.1 * h, 0.9 * h, 'charcoal'),
-            _blk(xf + ft, xf + 1.2 * ft, w / 2 - 0.8 * panel, w / 2 - 0.2 * panel, 0.7 * h, 0.8 * h, 'led')] + (
-        _fronts(xf, d, [door], _Finish('steel', 'black', 'steel')) + buttons)
+            _blk(xf + ft, xf + 1.2 * ft, w / 2 - 0.8 * panel, w / 2 - 0.2 * panel, 0.7 * h, 0.8 * h,
+                 'led')] + _fronts(xf, d, [door], _Finish('steel', 'black', 'steel')) + buttons
 
 
 def _dishwasher(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
@@ -871,20 +882,21 @@ def _washbasin(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     parts = [_soft(0.0, d, -w / 2, w / 2, counter - basin, counter, 'ceramic', 0.3 * basin),
              _blk(0.25 * d, 0.9 * d, -0.38 * w, 0.38 * w, counter - 0.01 * basin, counter + 0.02 * basin,
                   'ceramic_shade')]
-    parts += _tap(0.1 * d, 0.0, counter, counter + 0.7 * (h - counter) if tall else h, 0.2 * d)
+    parts += _tap(0.1 * d, 0.0, counter, counter + 0.3 * (h - counter) if tall else h, 0.2 * d)
     if tall:
         above = h - counter
-        parts += _frame(0.0, 0.05 * d, -0.42 * w, 0.42 * w, counter + 0.75 * above, h, 0.06 * above,
+        parts += _frame(0.0, 0.05 * d, -0.42 * w, 0.42 * w, counter + 0.4 * above, h, 0.06 * above,
                         'wood_medium' if style == 0 else 'chrome')
-        parts.append(_blk(0.0, 0.04 * d, -0.4 * w, 0.4 * w, counter + 0.75 * above, h, 'mirror'))
+        parts.append(_blk(0.0, 0.04 * d, -0.4 * w, 0.4 * w, counter + 0.4 * above, h, 'mirror'))
     if style == 1:
         return parts + [_disc(0.35 * d, 0.0, 0.0, counter - basin, 0.18 * d, 0.12 * w, 'ceramic', 8, top=1.3)]
-    finish = _Finish('wood_medium', 'wood_medium', 'chrome') if style == 0 else _Finish('white', 'white', 'chrome')
+    body = 'wood_medium' if style == 0 else 'white'
+    finish = _Finish(body, body, 'chrome')
     z0 = 0.0 if style == 0 else 0.25 * counter  # the drawer unit hangs on the wall over its waste pipe
     carcass, xf = _carcass(d, -0.48 * w, 0.48 * w, z0, counter - basin, finish.body)
     if style == 0:
-        return parts + [carcass] + _fronts(xf, d, _door_row(-0.48 * w, 0.48 * w, z0, counter - basin, 2, 'top'),
-                                           finish)
+        doors = _door_row(-0.48 * w, 0.48 * w, z0, counter - basin, 2, 'top')
+        return parts + [carcass] + _fronts(xf, d, doors, finish)
     return parts + [carcass, _post(0.2 * d, 0.0, 0.0, z0, min(0.02, 0.05 * w), 'chrome')] + _fronts(
         xf, d, _drawer_grid(-0.48 * w, 0.48 * w, z0, counter - basin, 2, 1), finish)
 
@@ -894,7 +906,8 @@ def _shower(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     tray = min(0.12, 0.06 * h)
     t = min(0.03, 0.04 * min(d, w))
     g = 0.3 * t
-    parts = [_blk(0.0, d, -w / 2, w / 2, 0.0, tray, 'ceramic'), _blk(0.0, g, -w / 2, w / 2, tray, h, 'ceramic_shade')]
+    parts = [_blk(0.0, d, -w / 2, w / 2, 0.0, tray, 'ceramic'),
+             _blk(0.0, g, -w / 2, w / 2, tray, h, 'ceramic_shade')]
     parts += [_blk(x, x + t, y, y + t, tray, h, 'chrome') for x in (0.0, d - t) for y in (-w / 2, w / 2 - t)]
     parts += [_blk(0.0, d, y, y + t, h - t, h, 'chrome') for y in (-w / 2, w / 2 - t)]
     parts += [_blk(d - t, d, -w / 2 + t, w / 2 - t, h - t, h, 'chrome'),
@@ -925,7 +938,8 @@ def _bathtub(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     parts += _tap(0.3 * rim, -w / 2 + 0.5 * rim, rim_h, rim_h + tap, 0.0)
     if h > 1.2:
         screen, r = 0.1 * rim, min(0.012, 0.03 * d)
-        parts += [_blk(d - rim / 2 - screen, d - rim / 2 + screen, -w / 2 + rim, -0.05 * w, rim_h, 0.85 * h, 'glass'),
+        xs = d - rim / 2
+        parts += [_blk(xs - screen, xs + screen, -w / 2 + rim, -0.05 * w, rim_h, 0.85 * h, 'glass'),
                   _post(2 * r, -w / 2 + rim, rim_h, h, r, 'chrome'),
                   _disc(0.1 * d, -w / 2 + rim, h - 0.02 * h, h, 0.1 * d, 0.1 * d, 'chrome', 8)]
     return parts
@@ -946,7 +960,8 @@ def _towel(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
              _blk(xc + r, 0.95 * d, -0.44 * w, 0.44 * w, 0.0, bar_z, cloth),
              _soft(0.15 * d, 0.95 * d, -0.44 * w, 0.44 * w, bar_z - r, h, cloth, 0.3 * d)]
     if stripe:
-        parts += [_blk(0.95 * d, d, -0.44 * w, 0.44 * w, z, z + 0.05 * h, stripe) for z in (0.08 * h, 0.16 * h)]
+        parts += [_blk(0.95 * d, d, -0.44 * w, 0.44 * w, z, z + 0.05 * h, stripe)
+                  for z in (0.08 * h, 0.16 * h)]
     return parts
 
 
@@ -1106,8 +1121,8 @@ def _picture(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     """Framed canvas hanging on a wall at x = 0; variants differ in frame and painting."""
     frame, art = _pick(_ART, v)
     f = min(0.05, 0.08 * min(w, h))
-    return _frame(0.0, d, -w / 2, w / 2, 0.0, h, f, frame) + _canvas(0.5 * d, 0.7 * d, -w / 2 + f, w / 2 - f,
-                                                                    f, h - f, art)
+    canvas = _canvas(0.5 * d, 0.7 * d, -w / 2 + f, w / 2 - f, f, h - f, art)
+    return _frame(0.0, d, -w / 2, w / 2, 0.0, h, f, frame) + canvas
 
 
 def _canvas(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float, art: str) -> Parts:
@@ -1128,17 +1143,18 @@ def _canvas(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float, ar
     if art == 'sea':
         return [at(0, 1, 0.5, 1, 'sky', 0), at(0, 1, 0.2, 0.5, 'sea', 0), at(0, 1, 0, 0.2, 'sand', 0),
                 at(0.55, 0.62, 0.5, 0.78, 'white'), at(0.15, 0.3, 0.75, 0.82, 'white')]
+    circles = ((0.3, 0.6, 0.22, 'art_red'), (0.65, 0.35, 0.2, 'art_yellow'), (0.72, 0.75, 0.12, 'sun'))
     return [at(0, 1, 0, 1, 'grey_dark', 0)] + [
-        _rod((x1, y0 + a * cw, z0 + b * ch), (x1 + step, y0 + a * cw, z0 + b * ch), r * min(cw, ch), colour, 10)
-        for a, b, r, colour in ((0.3, 0.6, 0.22, 'art_red'), (0.65, 0.35, 0.2, 'art_yellow'),
-                                (0.72, 0.75, 0.12, 'sun'))]
+        _rod((x1, y0 + a * cw, z0 + b * ch), (x1 + step, y0 + a * cw, z0 + b * ch), r * min(cw, ch), colour,
+             10) for a, b, r, colour in circles]
 
 
 def _mirror(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     """Wall mirror: wide wooden frame; thin black frame; oval in a brass rim."""
     style = v % 3
     if style == 2:
-        return [_oval(0.0, 0.6 * d, w / 2, h / 2, h / 2, 'brass'), _oval(0.0, d, 0.45 * w, 0.45 * h, h / 2, 'mirror')]
+        return [_oval(0.0, 0.6 * d, w / 2, h / 2, h / 2, 'brass'),
+                _oval(0.0, d, 0.45 * w, 0.45 * h, h / 2, 'mirror')]
     f = min(0.06, 0.1 * min(w, h)) if style == 0 else min(0.02, 0.05 * min(w, h))
     return _frame(0.0, d, -w / 2, w / 2, 0.0, h, f, 'wood_medium' if style == 0 else 'black') + [
         _blk(0.0, 0.7 * d, -w / 2 + f, w / 2 - f, f, h - f, 'mirror')]
@@ -1190,7 +1206,8 @@ def _station(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
 
 # --- openings ------------------------------------------------------------------------------
 
-_DOORS = (('wood_medium', 'white', 'plain'), ('off_white', 'white', 'panels'), ('wood_dark', 'wood_dark', 'glass'))
+_DOORS = (('wood_medium', 'white', 'plain'), ('off_white', 'white', 'panels'),
+          ('wood_dark', 'wood_dark', 'glass'))
 
 
 def _door(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
@@ -1206,8 +1223,8 @@ def _door(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
         parts += [_blk(x0 - proud, x1 + proud, y0 + inset, y1 - inset, a * top, b * top, 'white')
                   for a, b in ((0.08, 0.42), (0.52, 0.92))]
     if style == 'glass':
-        parts += [_blk(x0 - proud / 2, x1 + proud / 2, y0 + 1.3 * inset, y1 - 1.3 * inset, a * top, b * top, 'glass')
-                  for a, b in ((0.45, 0.6), (0.64, 0.78), (0.82, 0.94))]
+        parts += [_blk(x0 - proud / 2, x1 + proud / 2, y0 + 1.3 * inset, y1 - 1.3 * inset, a * top, b * top,
+                       'glass') for a, b in ((0.45, 0.6), (0.64, 0.78), (0.82, 0.94))]
     return parts + _lever_handles(x0, x1, y1 - min(0.08, 0.12 * (y1 - y0)), min(1.0, 0.42 * h), w, h)
 
 
@@ -1219,8 +1236,10 @@ def _lever_handles(x0: float, x1: float, y: float, z: float, w: float, h: float)
     parts = []
     for face, out in ((x0, -1.0), (x1, 1.0)):
         tip = face + out * reach
-        parts += [_blk(face, face + out * 0.3 * reach, y - plate_w, y + plate_w, z - plate_h, z + plate_h, 'chrome'),
-                  _blk(tip - out * 0.3 * reach, tip, y - lever + plate_w, y + plate_w / 2, z - t, z + t, 'chrome')]
+        parts += [_blk(face, face + out * 0.3 * reach, y - plate_w, y + plate_w, z - plate_h, z + plate_h,
+                       'chrome'),
+                  _blk(tip - out * 0.3 * reach, tip, y - lever + plate_w, y + plate_w / 2, z - t, z + t,
+                       'chrome')]
     return parts
 
 
@@ -1233,11 +1252,13 @@ def _window(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     fw = min(0.07, 0.1 * min(w, h))
     sash, xm = min(0.04, 0.5 * fw), d / 2
     depth = min(2 * sash, 0.4 * d)
-    parts = _frame(0.0, d, -w / 2, w / 2, 0.0, h, fw, frame, bottom='grey_light' if frame == 'white' else 'white')
+    sill = 'grey_light' if frame == 'white' else 'white'
+    parts = _frame(0.0, d, -w / 2, w / 2, 0.0, h, fw, frame, bottom=sill)
     parts.append(_blk(xm - 0.1 * depth, xm + 0.1 * depth, -w / 2 + fw, w / 2 - fw, fw, h - fw, 'glass'))
     transom = fw + (0.55 if layout == 'cross' else 0.72) * (h - 2 * fw)
     if layout != 'casement':
-        parts.append(_blk(xm - depth, xm + depth, -w / 2 + fw, w / 2 - fw, transom - sash, transom + sash, frame))
+        parts.append(_blk(xm - depth, xm + depth, -w / 2 + fw, w / 2 - fw, transom - sash, transom + sash,
+                          frame))
     top = transom if layout == 'transom' else h - fw
     return parts + [_blk(xm - depth, xm + depth, -sash, sash, fw, top, frame)]
 
@@ -1265,9 +1286,9 @@ def _decoration(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
                       _ell(x - 0.3 * rx, x + 0.3 * rx, y - 0.3 * ry, y + 0.3 * ry, z - 0.05 * h, z + 0.1 * h,
                            ('art_red', 'art_yellow', 'fabric_pink')[i % 3])]
         return parts
+    tips = [(rx + 0.9 * rx * np.cos(a), 0.9 * ry * np.sin(a), h) for a in np.arange(7) * 2 * np.pi / 7]
     return [_disc(rx, 0.0, 0.0, 0.45 * h, 0.35 * rx, 0.35 * ry, 'white', 8, top=0.6)] + [
-        _beam((rx, 0.0, 0.4 * h), (rx + 0.9 * rx * np.cos(a), 0.9 * ry * np.sin(a), h), 0.04 * min(rx, ry), 'sand')
-        for a in np.arange(7) * 2 * np.pi / 7]
+        _beam((rx, 0.0, 0.4 * h), tip, 0.04 * min(rx, ry), 'sand') for tip in tips]
 
 
 def _flat_decoration(d: float, w: float, h: float, style: int) -> Parts:
@@ -1279,7 +1300,8 @@ def _flat_decoration(d: float, w: float, h: float, style: int) -> Parts:
         fruit = ((0.35 * d, -0.2 * w, 'fruit_orange'), (0.65 * d, -0.1 * w, 'fruit_red'),
                  (0.45 * d, 0.22 * w, 'fruit_green'))
         return [_disc(rx, 0.0, 0.0, 0.5 * h, 0.6 * rx, 0.6 * ry, 'wood_medium', 12, top=1 / 0.6)] + [
-            _ell(x - 0.25 * d, x + 0.25 * d, y - 0.25 * w, y + 0.25 * w, 0.3 * h, h, colour) for x, y, colour in fruit]
+            _ell(x - 0.25 * d, x + 0.25 * d, y - 0.25 * w, y + 0.25 * w, 0.3 * h, h, colour)
+            for x, y, colour in fruit]
     return [_blk(0.05 * d, 0.95 * d, -0.45 * w, 0.4 * w, 0.0, 0.33 * h, 'fabric_red'),  # stack of books
             _blk(0.0, 0.9 * d, -0.5 * w, 0.45 * w, 0.33 * h, 0.66 * h, 'fabric_navy'),
             _blk(0.1 * d, d, -0.4 * w, 0.5 * w, 0.66 * h, h, 'cream')]
@@ -1327,19 +1349,31 @@ def variant_count(object_type: str) -> int:
     return _SPECS.get(object_type, _GENERIC).variants
 
 
+def front_axis(object_type: str) -> str:
+    """Which box side a type's front belongs on: 'short', 'long' or 'any' (see ``facing.suits_box``).
+
+    Pass it to ``facing.choose_facing`` so that, say, a wardrobe in a corner
+    backs onto the wall behind its long side.
+    """
+    return _SPECS.get(object_type, _GENERIC).front
+
+
 def build_model(object_type: str, size: Sequence[float], variant: int, facing: int = 0,
                 prefab: str = '') -> Mesh:
     """Model of ``object_type`` filling the upright box ``size`` (sx, sy, sz) centred at the origin.
 
     ``variant`` is taken modulo ``variant_count``; ``facing`` (0..3) makes the
     front look along local +x, +y, -x, -y.  Types whose front belongs on a
-    particular side of the box (a bed's foot on the long axis, a wardrobe's
-    doors on its long side) turn a quarter when ``facing`` contradicts the box.
+    particular side of the box (``front_axis``: a bed's foot on the long axis,
+    a wardrobe's doors on its long side) turn a quarter when ``facing`` does
+    not suit the box.
     """
     spec = _SPECS.get(object_type, _GENERIC)
     extents = _clean_size(size)
-    facing = _resolve_facing(spec.front, extents, int(facing) % 4)
-    d, w, h = (extents[0], extents[1], extents[2]) if facing % 2 == 0 else (extents[1], extents[0], extents[2])
+    facing = int(facing) % 4
+    if not suits_box(spec.front, extents, facing):
+        facing = (facing + 1) % 4
+    d, w, h = extents[[0, 1, 2] if facing % 2 == 0 else [1, 0, 2]]
     mesh = Mesh.merged(spec.build(d, w, h, int(variant) % spec.variants, prefab or ''))
     return _fit(mesh, (d, w, h)).transformed(facing * np.pi / 2)
 
@@ -1347,13 +1381,6 @@ def build_model(object_type: str, size: Sequence[float], variant: int, facing: i
 def _clean_size(size: Sequence[float]) -> np.ndarray:
     values = np.abs(np.asarray(size, np.float64).reshape(3))
     return np.maximum(np.where(np.isfinite(values), values, MIN_EXTENT), MIN_EXTENT)
-
-
-def _resolve_facing(front: str, size: np.ndarray, facing: int) -> int:
-    depth, width = (size[0], size[1]) if facing % 2 == 0 else (size[1], size[0])
-    if (front == 'short' and depth > SWAP_RATIO * width) or (front == 'long' and width > SWAP_RATIO * depth):
-        return (facing + 1) % 4
-    return facing
 
 
 def _fit(mesh: Mesh, size: Sequence[float]) -> Mesh:

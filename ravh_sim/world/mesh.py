@@ -68,8 +68,10 @@ class Mesh:
         return Mesh(self.vertices @ matrix.T + np.asarray(translation, np.float64), faces, self.colours)
 
     def scaled(self, factors: Vec3 | float) -> Mesh:
-        """Scale about the origin by positive per-axis factors."""
-        return Mesh(self.vertices * np.asarray(factors, np.float64), self.faces, self.colours)
+        """Scale about the origin per axis; a mirroring scale also reverses the face winding."""
+        factors = np.broadcast_to(np.asarray(factors, np.float64), (3,))
+        faces = self.faces if np.prod(np.sign(factors)) > 0 else self.faces[:, ::-1]
+        return Mesh(self.vertices * factors, faces, self.colours)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Axis-aligned (min corner, max corner)."""
@@ -98,17 +100,16 @@ class Mesh:
         Path(path).write_text(self.obj_text(palette), encoding='ascii')
 
     def obj_text(self, palette: UvSource) -> str:
+        """The text ``write_obj`` writes."""
         cross = self.face_cross()
         length = np.linalg.norm(cross, axis=1, keepdims=True)
         normals = np.where(length > 0, cross / np.where(length > 0, length, 1.0), (0.0, 0.0, 1.0))
         normals, normal_of_face = np.unique(_clean(normals, 4), axis=0, return_inverse=True)
-        normal_of_face = normal_of_face.reshape(-1)
         used, uv_of_face = np.unique(self.colours, return_inverse=True)
-        uv_of_face = uv_of_face.reshape(-1)
         uvs = [palette.uv(int(c)) for c in used]
-        corner = np.stack([self.faces + 1,
-                           np.repeat(uv_of_face.reshape(-1, 1) + 1, 3, axis=1),
-                           np.repeat(normal_of_face.reshape(-1, 1) + 1, 3, axis=1)], axis=2)
+        per_face = np.column_stack([uv_of_face.reshape(-1), normal_of_face.reshape(-1)]) + 1
+        corner = np.concatenate([self.faces[:, :, None] + 1, np.repeat(per_face[:, None, :], 3, axis=1)],
+                                axis=2)  # (face, corner, v/vt/vn)
         lines = [f'# ravh_sim procedural mesh: {len(self.vertices)} vertices, '
                  f'{len(self.faces)} triangles']
         lines += ['v %.5f %.5f %.5f' % tuple(v) for v in _clean(self.vertices, 5)]
@@ -176,16 +177,14 @@ def frustum(center: Vec3, radius_bottom: float, radius_top: float, height: float
     bottom = np.column_stack([ring * radius_bottom, np.full(n, -height / 2)])
     top = (np.array([[0.0, 0.0, height / 2]]) if top_is_apex
            else np.column_stack([ring * radius_top, np.full(n, height / 2)]))
-    k, k1 = np.arange(n), (np.arange(n) + 1) % n
+    k, k1, fan = np.arange(n), (np.arange(n) + 1) % n, np.arange(1, n - 1)
+    bottom_cap = np.column_stack([np.zeros(n - 2, int), fan + 1, fan])
     if top_is_apex:
-        sides = np.column_stack([k, k1, np.full(n, n)])
-        faces = np.concatenate([sides, np.column_stack([np.zeros(n - 2, int), k1[1:-1], k[1:-1]])])
+        faces = np.concatenate([np.column_stack([k, k1, np.full(n, n)]), bottom_cap])
     else:
         sides = np.concatenate([np.column_stack([k, k1, k1 + n]), np.column_stack([k, k1 + n, k + n])])
-        fan = np.arange(1, n - 1)
-        caps = np.concatenate([np.column_stack([np.full(n - 2, n), fan + n, fan + n + 1]),
-                               np.column_stack([np.zeros(n - 2, int), fan + 1, fan])])
-        faces = np.concatenate([sides, caps])
+        top_cap = np.column_stack([np.full(n - 2, n), fan + n, fan + n + 1])
+        faces = np.concatenate([sides, bottom_cap, top_cap])
     vertices = np.concatenate([bottom, top]) @ _AXIS_FRAMES[axis].T + np.asarray(center, np.float64)
     return _solid(vertices, faces, colour)
 
@@ -223,29 +222,24 @@ def rounded_box(center: Vec3, size: Vec3, colour: int, bevel: float) -> Mesh:
             point[axis] = corner[axis] * half[axis]
             index[corner, axis] = len(vertices)
             vertices.append(point)
-    faces = []
+    quads = []
     for axis in range(3):
         u, w = [a for a in range(3) if a != axis]
-        for sign in (-1, 1):
-            ring = [_corner(axis, sign, u, su, w, sw) for su, sw in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
-            faces += _quad_faces([index[c, axis] for c in ring])
-        for su in (-1, 1):
+        for sign in (-1, 1):  # the flat face
+            quads.append([index[_corner(axis, sign, u, su, w, sw), axis]
+                          for su, sw in ((-1, -1), (1, -1), (1, 1), (-1, 1))])
+        for su in (-1, 1):  # the chamfers along this axis
             for sw in (-1, 1):
-                ends = [_corner(axis, s, u, su, w, sw) for s in (-1, 1)]
-                faces += _quad_faces([index[ends[0], u], index[ends[1], u], index[ends[1], w], index[ends[0], w]])
-    faces += [[index[c, 0], index[c, 1], index[c, 2]] for c in signs]
-    return _convex(np.array(vertices), np.array(faces), center, colour)
+                lo, hi = (_corner(axis, s, u, su, w, sw) for s in (-1, 1))
+                quads.append([index[lo, u], index[hi, u], index[hi, w], index[lo, w]])
+    corners = np.array([[index[c, 0], index[c, 1], index[c, 2]] for c in signs])
+    return _convex(np.array(vertices), np.concatenate([_quads(quads), corners]), center, colour)
 
 
 def _corner(axis: int, sign: int, u: int, su: int, w: int, sw: int) -> tuple[int, int, int]:
     corner = [0, 0, 0]
     corner[axis], corner[u], corner[w] = sign, su, sw
     return tuple(corner)
-
-
-def _quad_faces(quad: Sequence[int]) -> list[list[int]]:
-    a, b, c, d = quad
-    return [[a, b, c], [a, c, d]]
 
 
 _PHI = (1.0 + 5.0 ** 0.5) / 2.0

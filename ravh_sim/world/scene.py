@@ -24,7 +24,7 @@ import pybullet as pb
 from ravh_sim.world import paints
 from ravh_sim.world.facing import choose_facing
 from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances
-from ravh_sim.world.furniture import build_model
+from ravh_sim.world.furniture import build_model, front_axis
 from ravh_sim.world.geometry import quaternion_from_yaw
 from ravh_sim.world.house import Door, House, HouseObject, Wall
 from ravh_sim.world.palette import PALETTE
@@ -167,7 +167,7 @@ class World:
             return self._door_body(self.house.door_by_id[obj.id], model)
         box = obj.box(model)
         walls = [(w.a, w.b) for w in self.house.walls if w.room == obj.room and w.kind != "lintel"]
-        facing = choose_facing(box.position[:2], obj.yaw, box.size, walls)
+        facing = choose_facing(box.position[:2], obj.yaw, box.size, walls, front=front_axis(obj.type))
         mesh = build_model(obj.type, box.size, model, facing=facing, prefab=obj.prefab)
         collision = -1
         if obj.type not in NON_SOLID_TYPES:
