@@ -26,6 +26,7 @@ setup(
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),
+        (f"lib/{PACKAGE}", sorted(str(p) for p in Path("scripts").iterdir())),
         *tree("houses"),
         *tree("config"),
     ],

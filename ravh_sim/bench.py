@@ -5,6 +5,7 @@ Timed tests are flaky on a shared 2-core machine; ratios measured side by side a
 """
 from __future__ import annotations
 
+import math
 import os
 import statistics
 import tempfile
@@ -13,10 +14,16 @@ from typing import Any, Callable
 
 LOAD_TARGET_S = 2.0
 TRIANGLE_TARGET_HOUSE23 = 60_000
+FREE_SPACE_TARGET_S = 1.0
+PLAN_TARGET_S = 0.1
+STEP_TARGET_S = 0.001
+NAV_HOUSE = 23
+STEP_SAMPLES = 2400             # physics steps timed (10 s of simulated time at 240 Hz)
 
 
 def run(what: str, houses: list[int] | None = None) -> dict[str, Any]:
-    benches: dict[str, Callable[..., dict[str, Any]]] = {"load": bench_load}
+    benches: dict[str, Callable[..., dict[str, Any]]] = {"load": bench_load, "nav": bench_nav,
+                                                          "sensors": bench_sensors}
     return benches[what](houses=houses)
 
 
@@ -88,3 +95,183 @@ def _bare_client() -> None:
     if loader is not None:
         pb.loadPlugin(loader.get_filename(), "_eglRendererPlugin", physicsClientId=client)
     pb.disconnect(client)
+
+
+def bench_nav(houses: list[int] | None = None) -> dict[str, Any]:
+    """Navigation and physics speed.
+
+    * free-space map per house (target < 1 s each), against rasterising the obstacles alone;
+    * a cross-house plan in house 23, station to the farthest room (target < 100 ms), against a
+      plan along the first straight stretch of the same path;
+    * one physics step with the robot driving in circles (target < 1 ms), against a step of the
+      same house with no robot;
+    * the real-time factor of that cross-house drive with the path follower and no sensors
+      (simulated seconds per wall second), against stepping the same house with no robot.
+    """
+    from ravh_sim.nav.follower import PathFollower, drive
+    from ravh_sim.nav.freespace import free_space, obstacles
+    from ravh_sim.nav.navigation import Navigation
+    from ravh_sim.nav.planner import plan_path
+    from ravh_sim.robot.profile import load_profile
+    from ravh_sim.robot.simulation import Simulation
+    from ravh_sim.world.house import available_houses, load_house
+    from ravh_sim.world.scene import World
+    from ravh_sim.world.settings import load_settings, resolve
+
+    settings = load_settings()
+    profile = load_profile()
+    per_house = {}
+    for n in houses or available_houses():
+        house = load_house(n)
+        resolved = resolve(settings, house)
+        raster_s, _ = _timed(lambda: obstacles(house, resolved.doors, resolved.models, profile.height))
+        map_s, _ = _timed(lambda: free_space(house, resolved.doors, resolved.models, profile.radius,
+                                             profile.height))
+        per_house[str(n)] = {"free_space_s": round(map_s, 4), "obstacles_only_s": round(raster_s, 4)}
+    map_times = [v["free_space_s"] for v in per_house.values()]
+
+    house = load_house(NAV_HOUSE)
+    world = World(house, resolve(settings, house), renderer="tiny")
+    try:
+        empty = Simulation(world, agents=[])
+        empty_step_s = _timed(lambda: empty.step(STEP_SAMPLES))[0] / STEP_SAMPLES
+        sim = Simulation(world)
+        robot = next(iter(sim.robots.values()))
+        navigation = Navigation(house, world.settings, robot.profile)
+        grid = navigation.map()
+        start, goal = robot.pose[:2], _farthest_goal(navigation, robot.pose[:2])
+        plan_s, path = _best_of(3, lambda: plan_path(grid, start, goal, house=house))
+        straight_s, _ = _best_of(3, lambda: plan_path(grid, start, path.points[1], house=house))
+        follower = PathFollower(robot, navigation, robot.profile)
+        follower.navigate_to(goal)
+        t0 = sim.time
+        timeout = 4 * path.length / profile.max_linear_speed
+        drive_s, status = _timed(lambda: drive(sim, follower, timeout))
+        drive_sim_s = sim.time - t0
+        robot.teleport(*goal, 0.0)             # the roomiest spot: circles there touch nothing
+        robot.set_command(profile.max_linear_speed, profile.max_angular_speed)
+        step_s = _timed(lambda: sim.step(STEP_SAMPLES))[0] / STEP_SAMPLES
+    finally:
+        world.close()
+    empty_rtf = 1.0 / (empty_step_s * world.physics_hz)
+    drive_rtf = drive_sim_s / drive_s
+    return {
+        "houses": per_house,
+        "free_space_s_max": max(map_times), "free_space_s_median": round(statistics.median(map_times), 4),
+        "free_space_target_s": FREE_SPACE_TARGET_S,
+        "free_space_max_over_target": round(max(map_times) / FREE_SPACE_TARGET_S, 3),
+        "free_space_over_obstacles_only_median": round(statistics.median(
+            v["free_space_s"] / v["obstacles_only_s"] for v in per_house.values()), 2),
+        f"plan_s_house{NAV_HOUSE}": round(plan_s, 4),
+        f"plan_length_m_house{NAV_HOUSE}": round(path.length, 2),
+        "plan_target_s": PLAN_TARGET_S, "plan_over_target": round(plan_s / PLAN_TARGET_S, 3),
+        "straight_plan_s": round(straight_s, 4), "plan_over_straight_plan": round(plan_s / straight_s, 2),
+        "step_with_robot_s": round(step_s, 7), "step_empty_s": round(empty_step_s, 7),
+        "step_target_s": STEP_TARGET_S, "step_over_target": round(step_s / STEP_TARGET_S, 3),
+        "step_with_robot_over_empty": round(step_s / empty_step_s, 2),
+        "drive_status": status.value, "drive_sim_s": round(drive_sim_s, 1), "drive_wall_s": round(drive_s, 2),
+        "drive_real_time_factor": round(drive_rtf, 1), "empty_world_real_time_factor": round(empty_rtf, 1),
+        "drive_over_empty_world": round(drive_rtf / empty_rtf, 2),
+    }
+
+
+def _best_of(n: int, fn: Callable[[], Any]) -> tuple[float, Any]:
+    """The least time of ``n`` runs (the others are noise from the machine) and the value."""
+    runs = [_timed(fn) for _ in range(n)]
+    return min(t for t, _ in runs), runs[0][1]
+
+
+def _farthest_goal(navigation: Any, start: tuple[float, float]) -> tuple[float, float]:
+    """The goal of the room whose path from ``start`` is longest."""
+    from ravh_sim.nav.planner import Unreachable
+
+    best = (-1.0, start)
+    for room in navigation.house.rooms:
+        try:
+            goal = navigation.room_goal(room.id, start)
+            best = max(best, (navigation.plan(start, goal).length, goal))
+        except Unreachable:
+            continue
+    return best[1]
+
+
+SENSOR_HOUSES = (15, 23)
+CAMERA_TARGET_MS = 40.0
+CAMERA_SPEEDUP_TARGET = 2.5
+SCAN_TARGET_MS = 2.0
+SENSOR_REPEATS = 3
+
+
+def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
+    """Sensor speed: one camera capture (RGB + depth + instance, 640x480, lighting pass included)
+    with EGL and with TinyRenderer (a World of each, same run, same poses) and their ratio; the
+    lighting pass alone (night, every light on: its worst case); one 360-ray laser scan.
+
+    Poses: the station and every room centre that lies inside its room, headings turning by 90
+    degrees, default settings (day, ceiling lights on). Medians over all poses and repeats.
+    """
+    from ravh_sim.robot.profile import load_profile
+    from ravh_sim.sensors.camera import SmartCamera
+    from ravh_sim.sensors.laser import Laser
+    from ravh_sim.world.appearance import Appearance
+    from ravh_sim.world.geometry import polygon_centroid
+    from ravh_sim.world.house import load_house
+    from ravh_sim.world.scene import World
+    from ravh_sim.world.settings import load_settings, resolve
+
+    settings = load_settings()
+    profile = load_profile()
+    detail: dict[str, Any] = {}
+    camera_ms: dict[str, list[float]] = {"egl": [], "tiny": []}
+    lighting_ms: list[float] = []
+    scan_ms: list[float] = []
+    for n in houses or SENSOR_HOUSES:
+        house = load_house(n)
+        poses = [(house.station.position[0], house.station.position[1], house.station.yaw)]
+        for i, room in enumerate(house.rooms):
+            cx, cy = polygon_centroid(room.floor)
+            if room.contains(cx, cy):
+                poses.append((cx, cy, i * math.pi / 2))
+        for renderer in ("egl", "tiny"):
+            world = World(house, resolve(settings, house), renderer=renderer)
+            if world.renderer != renderer:
+                world.close()
+                continue
+            camera = SmartCamera(world, profile.camera)
+            camera.capture(*poses[0])
+            times = [_timed(lambda: camera.capture(*pose))[0] * 1000
+                     for _ in range(SENSOR_REPEATS) for pose in poses]
+            camera_ms[renderer] += times
+            detail[f"house{n}_camera_ms_{renderer}"] = round(statistics.median(times), 2)
+            if renderer == "egl":
+                lighting_ms += _lighting_times(camera, Appearance(world), poses)
+                laser = Laser(world, profile.laser)
+                scan_ms += [_timed(lambda: laser.scan(*pose))[0] * 1000
+                            for _ in range(SENSOR_REPEATS * 5) for pose in poses]
+            world.close()
+    egl = round(statistics.median(camera_ms["egl"]), 2) if camera_ms["egl"] else None
+    tiny = round(statistics.median(camera_ms["tiny"]), 2) if camera_ms["tiny"] else None
+    return {
+        "camera_ms_egl": egl, "camera_ms_tiny": tiny,
+        "camera_speedup": round(tiny / egl, 2) if egl and tiny else None,
+        "lighting_ms": round(statistics.median(lighting_ms), 2) if lighting_ms else None,
+        "scan_ms": round(statistics.median(scan_ms), 3) if scan_ms else None,
+        "camera_ms_target": CAMERA_TARGET_MS, "camera_speedup_target": CAMERA_SPEEDUP_TARGET,
+        "scan_ms_target": SCAN_TARGET_MS, "image": [profile.camera.width, profile.camera.height_px],
+        "laser_rays": profile.laser.ray_count, **detail,
+    }
+
+
+def _lighting_times(camera, appearance, poses) -> list[float]:
+    """Milliseconds of the lighting pass alone over pre-rendered frames (night, all lights on)."""
+    appearance.set_sun("night")
+    appearance.set_lights("all", "on")
+    lights, sun = appearance.lights_on(), appearance.sun
+    times = []
+    for pose in poses:
+        frame = camera.render(*pose)
+        for _ in range(SENSOR_REPEATS):
+            seconds, _ = _timed(lambda: camera.lighting.apply(frame.rgb, frame.depth, frame.instance,
+                                                              frame.rotation, frame.position, sun, lights))
+            times.append(seconds * 1000)
+    return times

@@ -14,12 +14,17 @@ from pathlib import Path
 from typing import Callable
 
 from ravh_sim.errors import UserError
+from ravh_sim.nodes.launch import NODES
+from ravh_sim.nodes.launch import main as launch_node
 from ravh_sim.paths import HOUSES_DIR
 
 Command = Callable[[argparse.Namespace], int]
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if argv and argv[0] in NODES:                  # ROS nodes parse their own flags and --ros-args
+        return launch_node(argv[0], argv[1:])
     parser = _parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
@@ -103,6 +108,29 @@ def cmd_plan(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_map(args: argparse.Namespace) -> int:
+    from ravh_sim.nav.navigation import Navigation
+    from ravh_sim.robot.profile import load_profile
+    from ravh_sim.world.house import load_house
+    from ravh_sim.world.settings import load_settings, resolve
+    house = load_house(args.house)
+    settings = load_settings(args.config)
+    if args.doors:
+        settings["doors"] = {"all": args.doors, "set": {}}
+    resolved = resolve(settings, house, args.seed, str(args.config or "config/default.yaml"))
+    profile = load_profile(args.profile or (resolved.agents[0].profile if resolved.agents else "giraff"))
+    pgm, yaml_path = Navigation(house, resolved, profile, args.resolution).write_map(args.output)
+    print(f"wrote {pgm} and {yaml_path}")
+    return 0
+
+
+def _positive(text: str) -> float:
+    value = float(text)
+    if not 0.0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+    return value
+
+
 def cmd_footprint(args: argparse.Namespace) -> int:
     from ravh_sim.world.footprint import make_footprint, write_footprint
     house, resolved = _resolved(args)
@@ -119,6 +147,32 @@ def cmd_query(args: argparse.Namespace) -> int:
     return 0 if reply["ok"] else 1
 
 
+def cmd_render(args: argparse.Namespace) -> int:
+    from ravh_sim.robot.profile import load_profile
+    from ravh_sim.sensors.camera import SmartCamera, write_capture
+    from ravh_sim.world.appearance import Appearance
+    from ravh_sim.world.scene import World
+    house, resolved = _resolved(args)
+    with World(house, resolved, renderer=args.renderer) as world:
+        appearance = Appearance(world)
+        if args.sun is not None:
+            appearance.set_sun(_sun_value(args.sun))
+        if args.lights is not None:
+            appearance.set_lights("all", args.lights, args.seed)
+        camera = SmartCamera(world, load_profile(args.profile).camera)
+        paths = write_capture(camera, camera.capture(*args.pose), args.output)
+    print("wrote " + ", ".join(str(p) for p in paths))
+    return 0
+
+
+def _sun_value(text: str) -> float | str:
+    """--sun: degrees or a preset name."""
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
     from ravh_sim import bench
     result = bench.run(args.what, houses=args.houses)
@@ -133,7 +187,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
 # ---------------------------------------------------------------------------- parser
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="ravh", description="Robot@VirtualHome for ROS 2: tools.")
+    nodes = ", ".join(NODES)
+    parser = argparse.ArgumentParser(prog="ravh", description="Robot@VirtualHome for ROS 2: tools.",
+                                     epilog=f"ROS nodes, also runnable as 'ravh NODE --help': {nodes}")
     sub = parser.add_subparsers(metavar="COMMAND")
 
     p = sub.add_parser("import-houses", help="convert upstream house facts into houses/")
@@ -153,6 +209,15 @@ def _parser() -> argparse.ArgumentParser:
                    help="overlay a planned path between two points")
     p.set_defaults(func=cmd_plan)
 
+    p = sub.add_parser("map", help="write the robot's free-space map (ROS map_server PGM + YAML)")
+    _world_args(p)
+    p.add_argument("--doors", choices=("open", "closed", "random", "default"), default=None,
+                   help="every door's state (default: as the config says)")
+    p.add_argument("--resolution", type=_positive, default=0.05, help="metres per cell (default 0.05)")
+    p.add_argument("--profile", default=None, help="robot profile (default: the first agent's)")
+    p.add_argument("-o", "--output", type=Path, required=True, help="folder for map.pgm and map.yaml")
+    p.set_defaults(func=cmd_map)
+
     p = sub.add_parser("footprint", help="write the footprint (every object, id, mask colour, pose)")
     _world_args(p)
     p.add_argument("-o", "--output", type=Path, required=True, help="JSON file")
@@ -163,8 +228,20 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("request", help='JSON request, e.g. \'{"query": "objects_in_room", "room": "Bedroom_1"}\'')
     p.set_defaults(func=cmd_query)
 
+    p = sub.add_parser("render", help="render the robot camera's view: rgb, depth, mask and info.json")
+    _world_args(p)
+    p.add_argument("--pose", type=float, nargs=3, metavar=("X", "Y", "YAW"), required=True,
+                   help="robot pose on the floor (m, m, rad)")
+    p.add_argument("--sun", default=None, help="sun angle in degrees, or day, sunset, night (default: config)")
+    p.add_argument("--lights", choices=("on", "off", "random"), default=None,
+                   help="switch every light (default: config); random uses --seed")
+    p.add_argument("--renderer", choices=("auto", "egl", "tiny"), default="auto")
+    p.add_argument("--profile", default="giraff", help="robot profile for the camera (default: giraff)")
+    p.add_argument("-o", "--output", type=Path, required=True, help="output folder")
+    p.set_defaults(func=cmd_render)
+
     p = sub.add_parser("bench", help="measure speed; prints JSON with --json")
-    p.add_argument("what", choices=("load",), help="what to measure")
+    p.add_argument("what", choices=("load", "nav", "sensors"), help="what to measure")
     p.add_argument("--houses", type=int, nargs="*", default=None, help="houses to measure (default: all)")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_bench)

@@ -1,0 +1,148 @@
+"""Where behaviours go: the Wanderer's light waypoints and the Grid's lattice nodes.
+
+The paper's Wanderer visits every room through the floor projections of its ceiling lights (lights
+hang over the open middle of a room); a projection that lands on furniture is moved to the nearest
+free cell of the same room. The Grid behaviour visits lattice nodes every ``spacing`` metres over
+the free area, room by room, in a back-and-forth sweep so consecutive nodes are neighbours.
+"""
+from __future__ import annotations
+
+import math
+import random
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from ravh_sim.nav.grid import FREE, Grid
+from ravh_sim.world.geometry import Polygon, points_in_polygon
+from ravh_sim.world.house import House
+
+Point = tuple[float, float]
+ORDERS = ("cyclic", "once", "random")
+
+
+def reachable_mask(grid: Grid, start: Point) -> np.ndarray:
+    """FREE cells connected to the free cell nearest ``start``."""
+    free = (grid.data == FREE).astype(np.uint8)
+    _, labels = cv2.connectedComponents(free, connectivity=8)
+    r, c = nearest_free_cell(grid, start, free.astype(bool))
+    return labels == labels[r, c]
+
+
+def nearest_free_cell(grid: Grid, xy: Point, mask: np.ndarray) -> tuple[int, int]:
+    rows, cols = np.nonzero(mask)
+    if len(rows) == 0:
+        raise ValueError("no free cell in the map")
+    r0, c0 = grid.cell_of(*xy)
+    k = int(np.argmin((rows - r0) ** 2 + (cols - c0) ** 2))
+    return int(rows[k]), int(cols[k])
+
+
+@dataclass(frozen=True)
+class Layout:
+    """What behaviours need of a house: room floors and ceiling-light positions. Built from a House
+    here, or from ground-truth queries by the behaviour nodes (which only talk to the sim node)."""
+    rooms: dict[str, tuple[Polygon, ...]]          # room id -> floor polygons, in house order
+    ceiling_lights: tuple[tuple[str, Point], ...]  # (room id, (x, y))
+
+    @classmethod
+    def of(cls, house: House) -> Layout:
+        return cls({r.id: (r.floor, *r.extra_floors) for r in house.rooms},
+                   tuple((lt.room, lt.position[:2]) for lt in house.lights if lt.kind == "ceiling"))
+
+
+def room_masks(layout: Layout, grid: Grid) -> dict[str, np.ndarray]:
+    """Per room, the grid cells whose centres lie on its floor."""
+    rows, cols = np.mgrid[0:grid.shape[0], 0:grid.shape[1]]
+    xs = grid.origin[0] + (cols + 0.5) * grid.resolution
+    ys = grid.origin[1] + (rows + 0.5) * grid.resolution
+    out = {}
+    for room_id, polygons in layout.rooms.items():
+        mask = np.zeros(grid.shape, bool)
+        for poly in polygons:
+            mask |= points_in_polygon(xs, ys, poly)
+        out[room_id] = mask
+    return out
+
+
+def light_waypoints(layout: Layout, grid: Grid, start: Point) -> dict[str, list[Point]]:
+    """Per room (house order), waypoints under its ceiling lights snapped into reachable free space;
+    a room without a reachable light gets its most open reachable point. Unreachable rooms are left out."""
+    reach = reachable_mask(grid, start)
+    clearance = cv2.distanceTransform(reach.astype(np.uint8), cv2.DIST_L2, 5)
+    out: dict[str, list[Point]] = {}
+    for room_id, mask in room_masks(layout, grid).items():
+        usable = mask & reach
+        if not usable.any():
+            continue
+        points = []
+        for light_room, xy in layout.ceiling_lights:
+            if light_room == room_id:
+                r, c = nearest_free_cell(grid, xy, usable)
+                points.append(grid.center_of(r, c))
+        if not points:
+            r, c = np.unravel_index(int(np.argmax(np.where(usable, clearance, -1))), grid.shape)
+            points.append(grid.center_of(int(r), int(c)))
+        out[room_id] = _dedupe(points, grid.resolution * 4)
+    return out
+
+
+def room_order(rooms: list[str], mode: str, rng: random.Random) -> list[str]:
+    """The order rooms are visited in one round: as listed (cyclic/once) or shuffled (random)."""
+    if mode not in ORDERS:
+        raise ValueError(f"order must be one of {ORDERS}, got {mode!r}")
+    order = list(rooms)
+    if mode == "random":
+        rng.shuffle(order)
+    return order
+
+
+def grid_nodes(layout: Layout, grid: Grid, start: Point, spacing: float = 0.5) -> list[Point]:
+    """Lattice nodes every ``spacing`` m on reachable free cells, room by room (nearest room next),
+    sweeping each room row by row in alternating directions."""
+    reach = reachable_mask(grid, start)
+    step = max(1, int(round(spacing / grid.resolution)))
+    by_room: dict[str, list[tuple[int, int]]] = {}
+    masks = room_masks(layout, grid)
+    for room_id, mask in masks.items():
+        lattice = np.zeros(grid.shape, bool)
+        lattice[step // 2::step, step // 2::step] = True
+        rows, cols = np.nonzero(lattice & mask & reach)
+        if len(rows):
+            by_room[room_id] = list(zip(rows.tolist(), cols.tolist()))
+    nodes: list[Point] = []
+    here = start
+    remaining = dict(by_room)
+    while remaining:
+        room_id = min(remaining, key=lambda rid: _distance_to_cells(grid, here, remaining[rid]))
+        cells = _serpentine(remaining.pop(room_id))
+        pts = [grid.center_of(r, c) for r, c in cells]
+        if math.dist(here, pts[-1]) < math.dist(here, pts[0]):
+            pts.reverse()
+        nodes += pts
+        here = pts[-1]
+    return nodes
+
+
+def _serpentine(cells: list[tuple[int, int]]) -> list[tuple[int, int]]:
+    rows: dict[int, list[int]] = {}
+    for r, c in cells:
+        rows.setdefault(r, []).append(c)
+    out = []
+    for i, r in enumerate(sorted(rows)):
+        cols = sorted(rows[r], reverse=bool(i % 2))
+        out += [(r, c) for c in cols]
+    return out
+
+
+def _distance_to_cells(grid: Grid, xy: Point, cells: list[tuple[int, int]]) -> float:
+    return min(math.dist(xy, grid.center_of(r, c)) for r, c in cells)
+
+
+def _dedupe(points: list[Point], min_gap: float) -> list[Point]:
+    out: list[Point] = []
+    for p in points:
+        if all(math.dist(p, q) >= min_gap for q in out):
+            out.append(p)
+    return out

@@ -1,0 +1,93 @@
+"""The Navigation Manager: the free-space map of a house as it is now, and paths over it.
+
+It watches the settings a World changes at run time (doors, object models) rather than the World
+itself, so the same object serves the simulator (pass ``world.house, world.settings``: the World
+updates those settings in place) and tools that never start pybullet (``ravh map``). The map is
+rebuilt only when a door or a model differs from what it was built from.
+"""
+from __future__ import annotations
+
+from pathlib import Path as FilePath
+
+import cv2
+import numpy as np
+
+from ravh_sim.nav.freespace import distance_to_obstacle, free_space
+from ravh_sim.nav.grid import FREE, Grid
+from ravh_sim.nav.mapio import write_map
+from ravh_sim.nav.planner import Path, Point, Unreachable, plan_path
+from ravh_sim.world.geometry import points_in_polygon
+from ravh_sim.robot.profile import RobotProfile
+from ravh_sim.world.house import House
+from ravh_sim.world.settings import Resolved
+
+DEFAULT_RESOLUTION = 0.05        # m per cell, as the ROS map_server maps the project writes
+START_SNAP = 0.3                 # m, as the planner: a start on the inflation uses the free cell nearby
+
+
+class Navigation:
+    """Free-space map and planner for one robot profile (its radius and height shape the map)."""
+
+    def __init__(self, house: House, settings: Resolved, profile: RobotProfile,
+                 resolution: float = DEFAULT_RESOLUTION) -> None:
+        self.house, self.settings, self.profile, self.resolution = house, settings, profile, resolution
+        self._built_from: tuple[dict[str, bool], dict[str, int]] | None = None
+        self._grid: Grid | None = None
+
+    def map(self) -> Grid:
+        """The free-space grid for the current doors and models (the same object until they change)."""
+        state = (dict(self.settings.doors), dict(self.settings.models))
+        if self._grid is None or state != self._built_from:
+            self._grid = free_space(self.house, state[0], state[1], radius=self.profile.radius,
+                                    height=self.profile.height, resolution=self.resolution)
+            self._built_from = state
+        return self._grid
+
+    def closed_doors(self) -> list[str]:
+        return [door for door, is_open in self.settings.doors.items() if not is_open]
+
+    def plan(self, start: Point, goal: Point) -> Path:
+        """A path on the current map; raises :class:`~ravh_sim.nav.planner.Unreachable` naming the
+        rooms and the closed doors when there is none."""
+        return plan_path(self.map(), start, goal, house=self.house, blocked_by=self.closed_doors())
+
+    def room_goal(self, room_id: str, start: Point | None = None) -> Point:
+        """The free point of a room farthest from obstacles (where to send a robot told "go to the
+        kitchen"), among the points reachable from ``start`` if given. Raises
+        :class:`~ravh_sim.nav.planner.Unreachable` when the room has no such point."""
+        room = self.house.room(room_id)
+        grid = self.map()
+        rows, cols = np.indices(grid.shape)
+        xs = grid.origin[0] + (cols + 0.5) * grid.resolution
+        ys = grid.origin[1] + (rows + 0.5) * grid.resolution
+        usable = np.zeros(grid.shape, bool)
+        for poly in (room.floor, *room.extra_floors):
+            usable |= points_in_polygon(xs, ys, poly)
+        usable &= grid.data == FREE
+        if start is not None:
+            usable &= _component_of(grid, start)
+        score = np.where(usable, distance_to_obstacle(grid), -1.0)
+        r, c = np.unravel_index(int(np.argmax(score)), score.shape)
+        if score[r, c] <= 0:
+            where = "" if start is None else f" reachable from ({start[0]:.2f}, {start[1]:.2f})"
+            raise Unreachable("goal", f"room {room_id} has no free point{where}")
+        return grid.center_of(int(r), int(c))
+
+    def write_map(self, directory: str | FilePath) -> tuple[FilePath, FilePath]:
+        """``map.pgm`` and ``map.yaml`` (ROS map_server format) of the current map."""
+        return write_map(self.map(), directory)
+
+
+def _component_of(grid: Grid, start: Point) -> np.ndarray:
+    """Mask of the free cells connected (4-connected, as the planner moves) to the free cell
+    nearest ``start`` within START_SNAP; all False if there is none."""
+    free = (grid.data == FREE).astype(np.uint8)
+    _, labels = cv2.connectedComponents(free, connectivity=4)
+    r, c = grid.cell_of(*start)
+    k = int(START_SNAP / grid.resolution) + 1
+    r0, c0 = max(r - k, 0), max(c - k, 0)
+    rr, cc = np.nonzero(free[r0:max(r + k + 1, 0), c0:max(c + k + 1, 0)])
+    if rr.size == 0:
+        return np.zeros(grid.shape, bool)
+    nearest = int(np.argmin(np.hypot(rr + r0 - r, cc + c0 - c)))
+    return labels == labels[rr[nearest] + r0, cc[nearest] + c0]

@@ -1,0 +1,347 @@
+"""The sim node: a :class:`~ravh_sim.runtime.SimRuntime` on ROS 2 topics and services.
+
+``ros2 run ravh_sim sim --house 15`` (or ``ravh sim --house 15``). The node is the clock: it advances
+physics so that sim time follows wall time times the real-time factor (0 = as fast as possible),
+publishes /clock, and stamps everything with sim time. All names come from ``ravh_msgs_py.names``.
+Requests never take it down: bad commands are refused with a throttled warning, bad service
+requests get an error reply.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from typing import Any
+
+from diagnostic_msgs.srv import AddDiagnostics
+from geometry_msgs.msg import PoseStamped, TransformStamped, Twist, TwistStamped
+from nav_msgs.msg import OccupancyGrid, Odometry
+from nav_msgs.srv import GetMap, GetPlan
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import CameraInfo, CompressedImage, Image, LaserScan
+from std_msgs.msg import String
+from std_srvs.srv import Trigger
+
+from ravh_msgs_py import names as n
+from ravh_sim.errors import UserError
+from ravh_sim.nodes import convert
+from ravh_sim.nodes.common import COMMAND_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, run_node
+from ravh_sim.runtime import Agent, Rates, SimRuntime
+from ravh_sim.sensors.camera import CameraOptions
+from ravh_sim.sensors.imaging import encode_jpeg
+
+try:                                    # every full ROS install has tf2_msgs; the PyPI wheels do not
+    from tf2_msgs.msg import TFMessage
+except ImportError:                     # pragma: no cover - depends on the install
+    TFMessage = None
+
+TICK_S = 0.005                          # wall period of the stepping timer
+MAX_STEP_S = 0.1                        # sim time advanced per tick at most (keeps services responsive)
+CMD_TIMEOUT_S = 0.5                     # stop a robot whose commands stop arriving (sim seconds)
+WARN_THROTTLE_S = 2.0
+
+PARAMETERS: dict[str, Any] = {
+    "house": 15, "seed": -1, "config": "", "renderer": "auto", "real_time_factor": 1.0,
+    "camera_rate": 10.0, "scan_rate": 10.0, "odom_rate": 50.0, "clock_rate": 100.0,
+    "cmd_vel_stamped": False, "jpeg_quality": 90,
+}
+
+
+class SimNode(Node):
+    def __init__(self, overrides: dict[str, Any] | None = None) -> None:
+        params = [Parameter(k, value=v) for k, v in (overrides or {}).items()]
+        super().__init__("ravh_sim", parameter_overrides=params)
+        p = {k: self.declare_parameter(k, v).value for k, v in PARAMETERS.items()}
+        self.rtf = float(p["real_time_factor"])
+        if not math.isfinite(self.rtf) or self.rtf < 0:
+            raise UserError(f"real_time_factor must be >= 0 (0 = as fast as possible), got {self.rtf}")
+        self.jpeg_quality = int(p["jpeg_quality"])
+        self.runtime = SimRuntime(int(p["house"]), p["config"] or None, None if p["seed"] < 0 else int(p["seed"]),
+                                  renderer=p["renderer"],
+                                  rates=Rates(p["camera_rate"], p["scan_rate"], p["odom_rate"], p["clock_rate"]),
+                                  camera_options=CameraOptions())
+        rt = self.runtime
+        self.get_logger().info(
+            f"house {rt.house.number}: {len(rt.house.rooms)} rooms, {len(rt.house.objects)} objects, "
+            f"renderer {rt.world.renderer}, seed {rt.world.settings.seed}, real-time factor {self.rtf:g}")
+        self._make_publishers()
+        self._make_subscriptions(bool(p["cmd_vel_stamped"]))
+        self._make_services()
+        self._published_map = -1
+        self._last_warn = 0.0
+        self._last_cmd: dict[str, float] = {}
+        self._wall0, self._sim0 = time.monotonic(), rt.time
+        self._next_clock = 0.0
+        self._publish_latched()
+        self.timer = self.create_timer(TICK_S, self._tick)
+
+    # ------------------------------------------------------------------ set-up
+    def _make_publishers(self) -> None:
+        pub = self.create_publisher
+        self.clock_pub = pub(Clock, n.CLOCK, STATE_QOS)
+        self.map_pub = pub(OccupancyGrid, n.MAP, LATCHED_QOS)
+        self.footprint_pub = pub(String, n.GROUND_TRUTH, LATCHED_QOS)
+        self.labels_pub = pub(String, n.INSTANCE_LABELS, LATCHED_QOS)
+        self.tf_pub = pub(TFMessage, n.TF, STATE_QOS) if TFMessage else None
+        self.tf_static_pub = pub(TFMessage, n.TF_STATIC, LATCHED_QOS) if TFMessage else None
+        self.agent_pubs: dict[str, dict[str, Any]] = {}
+        for agent in self.runtime.agents:
+            def name(base: str, a: Agent = agent) -> str:
+                return n.agent_name(base, a.name, a.first)
+            self.agent_pubs[agent.name] = {
+                "scan": pub(LaserScan, name(n.SCAN), SENSOR_QOS),
+                "rgb": pub(Image, name(n.COLOR_IMAGE), SENSOR_QOS),
+                "rgb_info": pub(CameraInfo, name(n.COLOR_INFO), SENSOR_QOS),
+                "jpeg": pub(CompressedImage, name(n.COLOR_COMPRESSED), SENSOR_QOS),
+                "depth": pub(Image, name(n.DEPTH_IMAGE), SENSOR_QOS),
+                "depth_info": pub(CameraInfo, name(n.DEPTH_INFO), SENSOR_QOS),
+                "instance": pub(Image, name(n.INSTANCE_IMAGE), SENSOR_QOS),
+                "odom": pub(Odometry, name(n.ODOM), STATE_QOS),
+                "gt_pose": pub(PoseStamped, name(n.GROUND_TRUTH_POSE), STATE_QOS),
+                "odom_tf": pub(TransformStamped, name(n.ODOM_TRANSFORM), STATE_QOS),
+                "map_odom": pub(TransformStamped, name(n.MAP_TO_ODOM), STATE_QOS),
+                "room": pub(String, name(n.ROOM), LATCHED_QOS),
+                "capture": pub(String, name(n.CAPTURE_EVENT), STATE_QOS),
+                "static": {child: pub(TransformStamped, name(f"tf_static/{child}"), LATCHED_QOS)
+                           for child in (n.LASER_FRAME, n.CAMERA_FRAME, n.CAMERA_OPTICAL_FRAME)},
+                "last_room": None,
+            }
+
+    def _make_subscriptions(self, stamped: bool) -> None:
+        for agent in self.runtime.agents:
+            topic = n.agent_name(n.CMD_VEL, agent.name, agent.first)
+            if stamped:
+                self.create_subscription(TwistStamped, topic,
+                                         lambda m, a=agent: self._on_cmd(a, m.twist), COMMAND_QOS)
+            else:
+                self.create_subscription(Twist, topic, lambda m, a=agent: self._on_cmd(a, m), COMMAND_QOS)
+
+    def _make_services(self) -> None:
+        srv = self.create_service
+        srv(AddDiagnostics, n.QUERY_SERVICE, self._on_query)
+        srv(AddDiagnostics, n.APPEARANCE_SERVICE, self._on_appearance)
+        srv(GetMap, n.GET_MAP_SERVICE, self._on_get_map)
+        srv(GetPlan, n.GET_PLAN_SERVICE, self._on_get_plan)
+        srv(Trigger, n.RESET_SERVICE, self._on_reset)
+        for agent in self.runtime.agents:
+            srv(Trigger, n.agent_name(n.CAPTURE_SERVICE, agent.name, agent.first),
+                lambda req, res, a=agent: self._on_capture(a, res))
+
+    # ------------------------------------------------------------------ stepping
+    def _tick(self) -> None:
+        """Advance sim time towards wall time x RTF, publishing whatever falls due on the way."""
+        rt = self.runtime
+        if self.rtf > 0:
+            target = self._sim0 + self.rtf * (time.monotonic() - self._wall0)
+            target = min(target, rt.time + MAX_STEP_S)
+        else:
+            target = rt.time + MAX_STEP_S
+        deadline = time.monotonic() + MAX_STEP_S
+        while rt.time + 1e-9 < target and time.monotonic() < deadline:
+            self._watchdog()
+            rt.step()
+            self._publish_due()
+        if self.rtf > 0 and rt.time + MAX_STEP_S < self._sim0 + self.rtf * (time.monotonic() - self._wall0):
+            self._wall0, self._sim0 = time.monotonic(), rt.time       # fell behind: do not try to catch up
+
+    def _watchdog(self) -> None:
+        for agent in self.runtime.agents:
+            last = self._last_cmd.get(agent.name)
+            if last is not None and self.runtime.time - last > CMD_TIMEOUT_S:
+                agent.robot.set_command(0.0, 0.0)
+                del self._last_cmd[agent.name]
+
+    def _publish_due(self) -> None:
+        rt = self.runtime
+        if rt.time + 1e-9 >= self._next_clock:
+            self.clock_pub.publish(convert.clock(rt.time))
+            self._next_clock += 1.0 / max(rt.rates.clock, 1e-3)
+        if rt.map_version != self._published_map:
+            self._publish_map()
+        for agent in rt.agents:
+            if rt.due(agent, "odom"):
+                self._publish_state(agent)
+            if rt.due(agent, "scan"):
+                self._publish_scan(agent)
+            if rt.due(agent, "camera"):
+                self._publish_capture(agent)
+
+    # ------------------------------------------------------------------ publishing
+    def _publish_latched(self) -> None:
+        rt = self.runtime
+        footprint = rt.footprint()
+        self.footprint_pub.publish(String(data=json.dumps(footprint)))
+        labels = {str(row["id"]): {"name": row["name"], "kind": row["kind"], "type": row["type"],
+                                   "tags": row["tags"], "room": row["room"], "mask_color": row["mask_color"]}
+                  for row in footprint["instances"]}
+        self.labels_pub.publish(String(data=json.dumps(labels)))
+        self._publish_map()
+        for agent in rt.agents:
+            self._publish_static(agent)
+
+    def _publish_map(self) -> None:
+        rt = self.runtime
+        self._published_map = rt.map_version
+        self.map_pub.publish(convert.occupancy_grid(rt.navigation.map(), convert.header(rt.time, n.MAP_FRAME),
+                                                    rt.time))
+        self.footprint_pub.publish(String(data=json.dumps(rt.footprint())))
+
+    def _frame(self, agent: Agent, frame: str) -> str:
+        return n.agent_name(frame, agent.name, agent.first)
+
+    def _publish_static(self, agent: Agent) -> None:
+        t = self.runtime.time
+        transforms = [convert.transform(convert.header(t, self._frame(agent, parent)), self._frame(agent, child),
+                                        xyz, quat)
+                      for parent, child, xyz, quat in self.runtime.static_transforms(agent)]
+        for tf in transforms:
+            self.agent_pubs[agent.name]["static"][tf.child_frame_id.split("/")[-1]].publish(tf)
+        if self.tf_static_pub:
+            self.tf_static_pub.publish(TFMessage(transforms=transforms))
+
+    def _publish_state(self, agent: Agent) -> None:
+        rt, pubs = self.runtime, self.agent_pubs[agent.name]
+        t = rt.time
+        odom_pose, true_pose = agent.robot.odometry, agent.robot.pose
+        v, w = agent.robot.velocity
+        odom_hdr = convert.header(t, self._frame(agent, n.ODOM_FRAME))
+        base = self._frame(agent, n.BASE_FRAME)
+        pubs["odom"].publish(convert.odometry(odom_pose, v, w, odom_hdr, base,
+                                              (agent.profile.odom_linear_sigma, agent.profile.odom_angular_sigma)))
+        pubs["gt_pose"].publish(convert.pose_stamped(true_pose, convert.header(t, n.MAP_FRAME)))
+        odom_tf = convert.transform_2d(odom_hdr, base, odom_pose)
+        map_odom = convert.transform_2d(convert.header(t, n.MAP_FRAME), odom_hdr.frame_id,
+                                        rt.map_to_odom(agent))
+        pubs["odom_tf"].publish(odom_tf)
+        pubs["map_odom"].publish(map_odom)
+        if self.tf_pub:
+            self.tf_pub.publish(TFMessage(transforms=[map_odom, odom_tf]))
+        room = rt.room_of(agent)
+        if room != pubs["last_room"]:
+            pubs["last_room"] = room
+            pubs["room"].publish(String(data=room or ""))
+
+    def _publish_scan(self, agent: Agent) -> None:
+        scan = self.runtime.scan(agent)
+        hdr = convert.header(self.runtime.time, self._frame(agent, n.LASER_FRAME))
+        self.agent_pubs[agent.name]["scan"].publish(convert.laser_scan(
+            scan.ranges, scan.angle_min, scan.angle_increment, scan.range_min, scan.range_max,
+            scan.scan_time, hdr))
+
+    def _publish_capture(self, agent: Agent) -> dict[str, Any]:
+        """One synchronised capture: RGB, JPEG, depth, instances and both camera_infos share one stamp."""
+        rt, pubs = self.runtime, self.agent_pubs[agent.name]
+        cap = rt.capture(agent)
+        hdr = convert.header(rt.time, self._frame(agent, n.CAMERA_OPTICAL_FRAME))
+        h, w = cap.rgb.shape[:2]
+        info = convert.camera_info(cap.K, w, h, hdr, cap.camera_info.D)
+        pubs["rgb"].publish(convert.image(cap.rgb, "rgb8", hdr))
+        pubs["rgb_info"].publish(info)
+        pubs["jpeg"].publish(convert.compressed(encode_jpeg(cap.rgb, self.jpeg_quality), hdr))
+        pubs["depth"].publish(convert.image(cap.depth, "32FC1", hdr))
+        pubs["depth_info"].publish(info)
+        pubs["instance"].publish(convert.image(cap.instance.astype("uint16"), "16UC1", hdr))
+        x, y, yaw = agent.robot.pose
+        event = {"agent": agent.name, "stamp": rt.time, "pose": [x, y, yaw], "room": rt.room_of(agent),
+                 "odom": list(agent.robot.odometry)}
+        pubs["capture"].publish(String(data=json.dumps(event)))
+        return event
+
+    # ------------------------------------------------------------------ callbacks
+    def _warn(self, text: str) -> None:
+        now = time.monotonic()
+        if now - self._last_warn >= WARN_THROTTLE_S:
+            self._last_warn = now
+            self.get_logger().warning(text)
+
+    def _on_cmd(self, agent: Agent, twist: Twist) -> None:
+        try:
+            self.runtime.command(agent, twist.linear.x, twist.angular.z)
+            self._last_cmd[agent.name] = self.runtime.time
+        except UserError as e:
+            self._warn(str(e))
+
+    def _on_query(self, request: AddDiagnostics.Request, response: AddDiagnostics.Response):
+        reply = self.runtime.query(request.load_namespace)
+        response.success, response.message = bool(reply["ok"]), json.dumps(reply)
+        return response
+
+    def _on_appearance(self, request: AddDiagnostics.Request, response: AddDiagnostics.Response):
+        reply = self.runtime.change_appearance(request.load_namespace)
+        response.success, response.message = bool(reply["ok"]), json.dumps(reply)
+        if reply["ok"]:
+            self._publish_map() if self.runtime.map_version != self._published_map else \
+                self.footprint_pub.publish(String(data=json.dumps(self.runtime.footprint())))
+        return response
+
+    def _on_get_map(self, request: GetMap.Request, response: GetMap.Response):
+        rt = self.runtime
+        response.map = convert.occupancy_grid(rt.navigation.map(), convert.header(rt.time, n.MAP_FRAME), rt.time)
+        return response
+
+    def _on_get_plan(self, request: GetPlan.Request, response: GetPlan.Response):
+        rt = self.runtime
+        start = (request.start.pose.position.x, request.start.pose.position.y)
+        goal = (request.goal.pose.position.x, request.goal.pose.position.y)
+        response.plan.header = convert.header(rt.time, n.MAP_FRAME)
+        if not all(math.isfinite(v) for v in (*start, *goal)):
+            self._warn("GetPlan: rejected non-finite start or goal")
+            return response
+        try:
+            path = rt.navigation.plan(start, goal)
+        except UserError as e:
+            self._warn(f"GetPlan: {e}")
+            return response
+        pts = path.points
+        for i, (x, y) in enumerate(pts):
+            nx, ny = pts[min(i + 1, len(pts) - 1)]
+            yaw = math.atan2(ny - y, nx - x) if (nx, ny) != (x, y) else 0.0
+            response.plan.poses.append(convert.pose_stamped((x, y, yaw), response.plan.header))
+        return response
+
+    def _on_reset(self, request: Trigger.Request, response: Trigger.Response):
+        try:
+            self.runtime.reset()
+            response.success, response.message = True, "agents back at their start poses"
+        except Exception as e:  # never die from a request
+            response.success, response.message = False, f"{type(e).__name__}: {e}"
+        return response
+
+    def _on_capture(self, agent: Agent, response: Trigger.Response):
+        try:
+            event = self._publish_capture(agent)
+            response.success, response.message = True, json.dumps(event)
+        except Exception as e:  # never die from a request
+            response.success, response.message = False, f"{type(e).__name__}: {e}"
+        return response
+
+    def close(self) -> None:
+        self.runtime.close()
+
+
+def parse_args(argv: list[str]) -> dict[str, Any]:
+    """Command-line flags (each also a ROS parameter: ``--ros-args -p house:=15`` works too)."""
+    p = argparse.ArgumentParser(prog="sim", description="ravh_sim: a Robot@VirtualHome house on ROS 2")
+    p.add_argument("--house", type=int)
+    p.add_argument("--seed", type=int)
+    p.add_argument("--config")
+    p.add_argument("--renderer", choices=("auto", "egl", "tiny"))
+    p.add_argument("--rtf", "--real-time-factor", dest="real_time_factor", type=float,
+                   help="sim seconds per wall second; 0 = as fast as possible (default 1)")
+    p.add_argument("--camera-rate", dest="camera_rate", type=float)
+    p.add_argument("--scan-rate", dest="scan_rate", type=float)
+    p.add_argument("--odom-rate", dest="odom_rate", type=float)
+    p.add_argument("--cmd-vel-stamped", dest="cmd_vel_stamped", action="store_true", default=None)
+    args = p.parse_args(argv)
+    return {k: v for k, v in vars(args).items() if v is not None}
+
+
+def main(argv: list[str] | None = None) -> int:
+    return run_node(lambda args: SimNode(parse_args(args)), argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

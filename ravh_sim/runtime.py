@@ -1,0 +1,267 @@
+"""The simulator without ROS: one house, its robots and sensors on one sim clock.
+
+:class:`SimRuntime` is what the sim node wraps: it builds the World from a house and settings, keeps
+the Simulation (physics + agents), each agent's camera and laser, the Navigation Manager and the
+ground truth, and says which sensors are due at the current sim time. Everything here is plain
+Python, so the whole data path (house file -> World -> sensors) is tested without a ROS graph, and the
+node only converts and publishes.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ravh_msgs_py import appearance as appearance_lang
+from ravh_msgs_py import names
+from ravh_msgs_py.query import BAD_REQUEST, INTERNAL, QueryError, error_reply, ok_reply
+from ravh_sim.errors import UserError
+from ravh_sim.nav.navigation import Navigation
+from ravh_sim.robot.profile import RobotProfile, load_profile
+from ravh_sim.robot.robot import Robot, compose, relative
+from ravh_sim.robot.simulation import Simulation
+from ravh_sim.sensors.camera import Capture, CameraOptions, SmartCamera
+from ravh_sim.sensors.laser import Laser, Scan
+from ravh_sim.world.appearance import Appearance
+from ravh_sim.world.footprint import make_footprint
+from ravh_sim.world.ground_truth import GroundTruth
+from ravh_sim.world.house import House, load_house
+from ravh_sim.world.scene import World
+from ravh_sim.world.settings import Resolved, load_settings, resolve
+
+# camera_link (x forward, z up) -> optical frame (z forward, x right, y down), REP 103
+OPTICAL_ROTATION = (-0.5, 0.5, -0.5, 0.5)
+
+# Commands beyond these magnitudes are refused as nonsense rather than clamped (clamping a
+# 1e9 m/s command would hide a unit bug in the sender); smaller overshoots are clamped by the robot.
+ABSURD_LINEAR = 10.0      # m/s
+ABSURD_ANGULAR = 20.0     # rad/s
+
+
+@dataclass
+class Rates:
+    """Sensor and state rates in Hz of sim time."""
+    camera: float = 10.0
+    scan: float = 10.0
+    odom: float = 50.0
+    clock: float = 100.0
+
+
+@dataclass
+class Agent:
+    name: str
+    robot: Robot
+    profile: RobotProfile
+    camera: SmartCamera
+    laser: Laser
+    first: bool                      # the first agent uses the plain topic names
+    next_due: dict[str, float] = field(default_factory=dict)
+
+
+class SimRuntime:
+    """A running house: physics, agents, sensors, appearance, navigation and ground truth."""
+
+    def __init__(self, house: int | House, config: str | Path | None = None, seed: int | None = None,
+                 renderer: str = "auto", rates: Rates | None = None,
+                 camera_options: CameraOptions | None = None) -> None:
+        self.house = house if isinstance(house, House) else load_house(house)
+        self.config_source = str(config or "config/default.yaml")
+        self.settings_doc = load_settings(config)
+        resolved = resolve(self.settings_doc, self.house, seed, self.config_source)
+        self.initial = Resolved.from_dict(resolved.to_dict())
+        self.world = World(self.house, resolved, renderer=renderer)
+        self.appearance = Appearance(self.world)
+        self.sim = Simulation(self.world)
+        self.rates = rates or Rates()
+        self.agents = []
+        for i, spec in enumerate(resolved.agents):
+            profile = load_profile(spec.profile)
+            robot = self.sim.robot(spec.name)
+            self.agents.append(Agent(spec.name, robot, profile,
+                                     SmartCamera(self.world, profile.camera, camera_options or CameraOptions()),
+                                     Laser(self.world, profile.laser), i == 0))
+        self.navigation = Navigation(self.house, self.world.settings, self.agents[0].profile
+                                     if self.agents else load_profile("giraff"))
+        self.map_version = 0
+        self._map_state = self._door_model_state()
+
+    # ------------------------------------------------------------------ time
+    @property
+    def time(self) -> float:
+        return self.sim.time
+
+    def step(self, n: int = 1) -> None:
+        self.sim.step(n)
+
+    def due(self, agent: Agent, what: str) -> bool:
+        """True (and schedules the next one) when ``what`` (camera, scan, odom) is due for ``agent``."""
+        rate = getattr(self.rates, what)
+        if rate <= 0:
+            return False
+        t = self.time
+        nxt = agent.next_due.get(what, 0.0)
+        if t + 1e-9 < nxt:
+            return False
+        period = 1.0 / rate
+        agent.next_due[what] = max(nxt + period, t + period * 0.5)
+        return True
+
+    # ------------------------------------------------------------------ sensing
+    def capture(self, agent: Agent) -> Capture:
+        x, y, yaw = agent.robot.pose
+        return agent.camera.capture(x, y, yaw, velocity=agent.robot.velocity)
+
+    def scan(self, agent: Agent) -> Scan:
+        x, y, yaw = agent.robot.pose
+        return agent.laser.scan(x, y, yaw, ignore_bodies=(agent.robot.body,))
+
+    def map_to_odom(self, agent: Agent) -> tuple[float, float, float]:
+        """The map -> odom transform: where odometry's origin lies given its drift so far."""
+        return compose(agent.robot.pose, relative(agent.robot.odometry, (0.0, 0.0, 0.0)))
+
+    def static_transforms(self, agent: Agent) -> list[tuple[str, str, tuple, tuple]]:
+        """(parent, child, xyz, quaternion xyzw) of the sensor mounts on base_link (at floor level)."""
+        cam, laser = agent.profile.camera, agent.profile.laser
+        pitch = math.radians(cam.pitch_deg)
+        return [
+            (names.BASE_FRAME, names.LASER_FRAME, (0.0, 0.0, laser.height), (0.0, 0.0, 0.0, 1.0)),
+            (names.BASE_FRAME, names.CAMERA_FRAME, (cam.forward, 0.0, cam.height),
+             (0.0, math.sin(pitch / 2), 0.0, math.cos(pitch / 2))),        # pitched down about +y
+            (names.CAMERA_FRAME, names.CAMERA_OPTICAL_FRAME, (0.0, 0.0, 0.0), OPTICAL_ROTATION),
+        ]
+
+    def room_of(self, agent: Agent) -> str | None:
+        room = self.house.room_at(*agent.robot.pose[:2])
+        return None if room is None else room.id
+
+    # ------------------------------------------------------------------ commands
+    def agent(self, name: str) -> Agent:
+        for a in self.agents:
+            if a.name == name:
+                return a
+        raise UserError(f"unknown agent {name!r}; valid: {', '.join(a.name for a in self.agents)}")
+
+    def command(self, agent: Agent, v: float, w: float) -> None:
+        """Velocity command; non-finite or absurd values raise UserError (the node warns)."""
+        if not (math.isfinite(v) and math.isfinite(w)):
+            raise UserError(f"rejected non-finite velocity command v={v}, w={w}")
+        if abs(v) > ABSURD_LINEAR or abs(w) > ABSURD_ANGULAR:
+            raise UserError(f"rejected absurd velocity command v={v:.3g} m/s, w={w:.3g} rad/s "
+                            f"(limits {agent.profile.max_linear_speed} m/s, "
+                            f"{agent.profile.max_angular_speed:.3g} rad/s)")
+        agent.robot.set_command(v, w)
+
+    def reset(self) -> None:
+        """Agents back to their start poses, stopped; appearance back to the initial settings."""
+        self.appearance.apply(self.initial)
+        for spec, agent in zip(self.initial.agents, self.agents):
+            agent.robot.set_command(0.0, 0.0)
+            agent.robot.teleport(*spec.pose)
+        self._check_map()
+
+    # ------------------------------------------------------------------ JSON services
+    def ground_truth(self) -> GroundTruth:
+        return GroundTruth(self.house, self.world.settings)
+
+    def query(self, text: str) -> dict[str, Any]:
+        return self.ground_truth().answer(text)
+
+    def change_appearance(self, text: str | dict) -> dict[str, Any]:
+        """Apply an appearance request (ravh_msgs_py.appearance); never raises."""
+        try:
+            request = appearance_lang.parse(text)
+            changed = self._apply_appearance(request)
+            self._check_map()
+            return ok_reply(changed)
+        except QueryError as e:
+            return e.reply()
+        except UserError as e:
+            return error_reply(BAD_REQUEST, str(e), getattr(e, "valid", None))
+        except Exception as e:  # a request must never take the node down
+            return error_reply(INTERNAL, f"{type(e).__name__}: {e}")
+
+    def _apply_appearance(self, req: dict[str, Any]) -> dict[str, Any]:
+        """Turn the request into settings overrides, resolve them like a settings file (same seed
+        rules), and apply only the items the request names."""
+        if "randomise" in req:
+            return {"settings": self.appearance.randomise(int(req["randomise"])).to_dict()}
+        self._check_names(req)
+        doc = json.loads(json.dumps(self.settings_doc))
+        doc["lights"]["set"], doc["doors"]["set"], doc["paint"]["rooms"], doc["models"]["set"] = {}, {}, {}, {}
+        target = Resolved.from_dict(self.world.settings.to_dict())
+        if "sun_angle" in req:
+            doc["lights"]["sun_angle"] = req["sun_angle"]
+        for which, state in req.get("lights", {}).items():
+            for light in self._lights_named(which):
+                doc["lights"]["set"][light] = state
+        for door, state in req.get("doors", {}).items():
+            for d in (self.house.door_by_id if door == "all" else [door]):
+                doc["doors"]["set"][d] = {True: "open", False: "closed"}.get(state, state)
+        for room, surfaces in req.get("paint", {}).items():
+            for r in (self.house.room_by_id if room == "all" else [room]):
+                doc["paint"]["rooms"][r] = dict(surfaces)
+        inherit = {}
+        for obj, model in req.get("models", {}).items():
+            for o in (self.house.object_by_id if obj == "all" else [obj]):
+                if isinstance(model, dict):
+                    inherit[o] = self.house.object(model["inherit"]).id
+                else:
+                    doc["models"]["set"][o] = model
+        seed = req.get("seed", self.world.settings.seed)
+        picked = resolve(doc, self.house, seed, "appearance request")
+        if "sun_angle" in req:
+            target.sun_angle = picked.sun_angle
+        for section in ("lights", "doors", "models"):
+            chosen = getattr(picked, section)
+            for item in doc[section]["set"]:
+                getattr(target, section)[item] = chosen[item]
+        for room, surfaces in doc["paint"]["rooms"].items():
+            for surface in surfaces:
+                target.paint[room][surface] = picked.paint[room][surface]
+        for obj, source in inherit.items():
+            target.models[obj] = target.models[source]
+        self.appearance.apply(target)
+        return {"settings": self.world.settings.to_dict()}
+
+    def _lights_named(self, which: str) -> list[str]:
+        kinds = {"all": ("ceiling", "lamp", "wall"), "ceiling": ("ceiling",), "lamps": ("lamp", "wall")}
+        if which in kinds:
+            return [lt.id for lt in self.house.lights if lt.kind in kinds[which]]
+        return [which]
+
+    def _check_names(self, req: dict[str, Any]) -> None:
+        h = self.house
+        for door in req.get("doors", {}):
+            if door != "all" and door not in h.door_by_id:
+                raise QueryError("unknown_id", f"unknown door {door!r}", ["all", *h.door_by_id])
+        for light in req.get("lights", {}):
+            if light not in ("all", "ceiling", "lamps") and light not in h.light_by_id:
+                raise QueryError("unknown_id", f"unknown light {light!r}", ["all", "ceiling", "lamps",
+                                                                              *h.light_by_id])
+        for room in req.get("paint", {}):
+            if room != "all" and room not in h.room_by_id:
+                raise QueryError("unknown_id", f"unknown room {room!r}", ["all", *h.room_by_id])
+        for obj in req.get("models", {}):
+            if obj != "all" and obj not in h.object_by_id:
+                raise QueryError("unknown_id", f"unknown object {obj!r}", ["all", *h.object_by_id])
+
+    # ------------------------------------------------------------------ map and footprint
+    def _door_model_state(self) -> str:
+        return json.dumps([self.world.settings.doors, self.world.settings.models], sort_keys=True)
+
+    def _check_map(self) -> bool:
+        """Bump the map version when doors or models changed (the node republishes /map)."""
+        state = self._door_model_state()
+        if state != self._map_state:
+            self._map_state = state
+            self.map_version += 1
+            return True
+        return False
+
+    def footprint(self) -> dict[str, Any]:
+        return make_footprint(self.house, self.world.settings)
+
+    def close(self) -> None:
+        self.world.close()

@@ -1,0 +1,268 @@
+"""The smart camera: RGB, depth and instance images from one pybullet render, pinhole-exact.
+
+One ``getCameraImage`` call gives colour, the depth buffer and the body segmentation. The OpenGL
+projection is built from K (fx, fy, cx, cy, near, far), so a 3D point projected with K lands on the
+pixel where it is drawn (OpenCV pixel convention: pixel i covers [i - 0.5, i + 0.5]). Depth is REP 118
+z-depth along the optical axis in metres (NaN where nothing is hit within ``far``); instance ids come
+from the World's body->instance table (0 = nothing). The lighting pass adds daylight colour, lamps and
+the sky; optional effects (motion blur, lens distortion, noise, JPEG) follow in that order, seeded
+from the world seed and a capture counter so the same seed and poses give identical images.
+
+Renderer: the EGL plugin (with its shadow-map pass switched off, see :mod:`egl`) or TinyRenderer
+when the World fell back to it; TinyRenderer gets the EGL shader's light coefficients so both agree.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pybullet as pb
+
+from ravh_sim.robot.profile import CameraSpec
+from ravh_sim.sensors import imaging
+from ravh_sim.sensors.egl import disable_shadow_map
+from ravh_sim.sensors.lighting import SUN_AMBIENT, SUN_DIFFUSE, Lighting
+from ravh_sim.sensors.mount import (CAMERA_OPTICAL_FRAME, LINK_TO_OPTICAL, floor_at, mount_position,
+                                    mount_rotation, quaternion_from_matrix)
+from ravh_sim.world.appearance import sun_light
+from ravh_sim.world.scene import World
+
+DISTORTION_MODEL = "plumb_bob"
+NOISE_STREAM = 1            # noise generator stream of cameras (lasers use another)
+# Optical frame -> OpenGL eye frame (x right, y up, z backwards).
+OPTICAL_TO_GL = np.diag([1.0, -1.0, -1.0])
+
+
+@dataclass(frozen=True)
+class CameraOptions:
+    """Realism effects; all off by default (the ideal pinhole camera)."""
+    jpeg_quality: int = 90                 # quality of encode_jpeg and of the round trip
+    jpeg_roundtrip: bool = False           # rgb shows JPEG artefacts
+    pixel_noise: float = 0.0               # Gaussian sigma, 8-bit levels
+    distortion: tuple[float, float, float, float, float] | None = None   # plumb-bob k1 k2 p1 p2 k3
+    motion_blur: bool = False
+    exposure: float = 0.02                 # s, for motion blur
+    depth_noise: float = 0.0               # sigma = depth_noise * z^2 (1/m)
+
+
+@dataclass(frozen=True)
+class CameraInfo:
+    """The fields of sensor_msgs/CameraInfo (row-major matrices)."""
+    frame_id: str
+    width: int
+    height: int
+    distortion_model: str
+    D: tuple[float, ...]
+    K: tuple[float, ...]
+    R: tuple[float, ...]
+    P: tuple[float, ...]
+
+
+@dataclass
+class Frame:
+    """One pybullet render, unlit: what the lighting pass and the effects start from."""
+    rgb: np.ndarray                        # (H, W, 3) uint8, albedo x pybullet's sun shading
+    depth: np.ndarray                      # (H, W) float32 z-depth, NaN = nothing
+    instance: np.ndarray                   # (H, W) uint16
+    background: np.ndarray                 # (H, W) bool, no body (sky)
+    position: np.ndarray                   # optical frame origin, house frame
+    rotation: np.ndarray                   # optical axes as columns, house frame
+
+
+@dataclass
+class Capture:
+    rgb: np.ndarray                        # (H, W, 3) uint8
+    depth: np.ndarray                      # (H, W) float32 metres, REP 118 z-depth, NaN = no return
+    instance: np.ndarray                   # (H, W) uint16 instance ids, 0 = nothing
+    K: np.ndarray                          # (3, 3)
+    camera_info: CameraInfo
+    robot_pose: tuple[float, float, float]
+    position: np.ndarray                   # optical frame origin, house frame
+    orientation: tuple[float, float, float, float]   # optical frame quaternion (x, y, z, w)
+    index: int                             # capture counter (noise stream)
+
+
+class SmartCamera:
+    """A camera mounted on a robot, rendering one World."""
+
+    def __init__(self, world: World, spec: CameraSpec, options: CameraOptions | None = None) -> None:
+        self.world, self.spec = world, spec
+        self.options = options or CameraOptions()
+        self.width, self.height = spec.width, spec.height_px
+        self.K = np.array([[spec.fx, 0.0, spec.cx], [0.0, spec.fy, spec.cy], [0.0, 0.0, 1.0]])
+        self.projection = projection_from_K(self.K, self.width, self.height, spec.near, spec.far)
+        self.camera_info = self._camera_info()
+        self._gl_projection = self.projection.T.ravel().tolist()      # column-major for pybullet
+        self._lens = (imaging.LensDistortion(self.K, self.options.distortion, self.width, self.height)
+                      if self.options.distortion is not None else None)
+        self.lighting = Lighting(world, self.K, self.width, self.height)
+        self._instance_rgb = np.zeros((max(i.id for i in world.instances) + 1, 3), np.uint8)
+        for inst in world.instances:
+            self._instance_rgb[inst.id] = inst.mask_color
+        if len(self._instance_rgb) > np.iinfo(np.uint16).max:
+            raise ValueError("too many instances for 16-bit instance images")
+        if world.renderer == "egl":
+            disable_shadow_map()
+        self.count = 0
+
+    # ------------------------------------------------------------------ geometry
+    def optical_pose(self, x: float, y: float, yaw: float, floor_z: float | None = None
+                     ) -> tuple[np.ndarray, np.ndarray]:
+        """(position, rotation 3x3 with the optical axes as columns) in the house frame."""
+        fz = floor_at(self.world, x, y) if floor_z is None else floor_z
+        position = mount_position(x, y, yaw, fz, self.spec.height, self.spec.forward)
+        rotation = mount_rotation(yaw, math.radians(self.spec.pitch_deg)) @ LINK_TO_OPTICAL
+        return position, rotation
+
+    def camera_pose(self, x: float, y: float, yaw: float, floor_z: float | None = None
+                    ) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+        """Position and quaternion (x, y, z, w) of the optical frame in the house frame (for TF)."""
+        position, rotation = self.optical_pose(x, y, yaw, floor_z)
+        return tuple(float(v) for v in position), quaternion_from_matrix(rotation)
+
+    def project(self, points: np.ndarray, x: float, y: float, yaw: float,
+                floor_z: float | None = None) -> np.ndarray:
+        """Pixel coordinates (N, 2) of house-frame points (N, 3) with K (NaN behind the camera)."""
+        position, rotation = self.optical_pose(x, y, yaw, floor_z)
+        cam = (np.atleast_2d(points) - position) @ rotation
+        with np.errstate(divide="ignore", invalid="ignore"):
+            uv = (cam @ self.K.T)[:, :2] / cam[:, 2:3]
+        uv[cam[:, 2] <= 0] = np.nan
+        return uv
+
+    # ------------------------------------------------------------------ capture
+    def render(self, x: float, y: float, yaw: float, floor_z: float | None = None) -> Frame:
+        """pybullet's render from robot pose (x, y, yaw), before lighting and effects."""
+        position, rotation = self.optical_pose(x, y, yaw, floor_z)
+        rgb, depth, instance, background = self._render(position, rotation,
+                                                         sun_light(self.world.settings.sun_angle).direction)
+        return Frame(rgb, depth, instance, background, position, rotation)
+
+    def capture(self, x: float, y: float, yaw: float, floor_z: float | None = None,
+                velocity: tuple[float, float] = (0.0, 0.0)) -> Capture:
+        """Render the view from robot pose (x, y, yaw); ``velocity`` (v m/s, w rad/s) for motion blur."""
+        opts = self.options
+        settings = self.world.settings
+        sun = sun_light(settings.sun_angle)
+        frame = self.render(x, y, yaw, floor_z)
+        depth, instance, background = frame.depth, frame.instance, frame.background
+        panes = self.lighting.glass_panes(depth, instance, frame.rotation, frame.position)
+        lights = [lt for lt in self.world.house.lights if settings.lights.get(lt.id, False)]
+        rgb = self.lighting.apply(frame.rgb, depth, instance, frame.rotation, frame.position, sun, lights)
+        if panes is not None:
+            glass = panes > 0
+            instance[glass] = panes[glass]
+            background |= glass
+        if background.any():
+            rgb[background] = sun.sky
+        rng = np.random.default_rng([settings.seed, NOISE_STREAM, self.count])
+        if opts.motion_blur and any(velocity):
+            distance = float(np.nanmedian(depth)) if np.isfinite(depth).any() else self.spec.far
+            rgb = imaging.motion_blur(rgb, self.K, velocity[0], velocity[1], opts.exposure, distance)
+        if self._lens is not None:
+            rgb = self._lens.apply(rgb)
+            depth = self._lens.apply(depth, nearest=True, fill=np.nan)
+            instance = self._lens.apply(instance, nearest=True)
+        if opts.pixel_noise > 0:
+            rgb = imaging.pixel_noise(rgb, opts.pixel_noise, rng)
+        if opts.depth_noise > 0:
+            depth = imaging.depth_noise(depth, opts.depth_noise, rng)
+        if opts.jpeg_roundtrip:
+            rgb = imaging.jpeg_roundtrip(rgb, opts.jpeg_quality)
+        capture = Capture(rgb, depth, instance, self.K.copy(), self.camera_info, (x, y, yaw), frame.position,
+                          quaternion_from_matrix(frame.rotation), self.count)
+        self.count += 1
+        return capture
+
+    def instance_color(self, capture: Capture) -> np.ndarray:
+        """(H, W, 3) uint8 image of the instance ids in their footprint mask colours (black = nothing)."""
+        return self._instance_rgb[capture.instance]
+
+    def encode_jpeg(self, rgb: np.ndarray) -> bytes:
+        return imaging.encode_jpeg(rgb, self.options.jpeg_quality)
+
+    def _render(self, position: np.ndarray, rotation: np.ndarray, light_direction
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """One pybullet render: (rgb uint8, z-depth float32, instance uint16, background mask)."""
+        view = view_matrix(position, rotation)
+        kwargs = {"lightDirection": list(light_direction)}
+        if self.world.renderer == "egl":
+            kwargs["renderer"] = pb.ER_BULLET_HARDWARE_OPENGL
+        else:
+            kwargs.update(renderer=pb.ER_TINY_RENDERER, shadow=0, lightColor=[1.0, 1.0, 1.0],
+                          lightAmbientCoeff=SUN_AMBIENT, lightDiffuseCoeff=SUN_DIFFUSE,
+                          lightSpecularCoeff=0.0)
+        _, _, rgba, buffer, seg = pb.getCameraImage(self.width, self.height, view.T.ravel().tolist(),
+                                                    self._gl_projection, physicsClientId=self.world.client,
+                                                    **kwargs)
+        rgba = np.asarray(rgba, np.uint8).reshape(self.height, self.width, 4)
+        buffer = np.asarray(buffer, np.float32).reshape(self.height, self.width)
+        seg = np.asarray(seg, np.int32).reshape(self.height, self.width)
+        background = seg < 0
+        near, far = self.spec.near, self.spec.far
+        depth = (far * near) / (far - (far - near) * buffer)
+        depth[background | (buffer >= 1.0)] = np.nan
+        lut = np.append(self.world.body_to_instance_lut(), 0).astype(np.uint16)  # seg -1 -> last entry
+        instance = np.take(lut, seg, mode="wrap")
+        return cv2.cvtColor(rgba, cv2.COLOR_RGBA2RGB), depth, instance, background
+
+    def _camera_info(self) -> CameraInfo:
+        k = self.K
+        d = self.options.distortion or (0.0, 0.0, 0.0, 0.0, 0.0)
+        p = np.hstack([k, np.zeros((3, 1))])
+        return CameraInfo(CAMERA_OPTICAL_FRAME, self.width, self.height, DISTORTION_MODEL,
+                          tuple(float(v) for v in d), tuple(float(v) for v in k.ravel()),
+                          tuple(float(v) for v in np.eye(3).ravel()), tuple(float(v) for v in p.ravel()))
+
+
+def projection_from_K(K: np.ndarray, width: int, height: int, near: float, far: float) -> np.ndarray:
+    """OpenGL projection (row-major 4x4) whose pixels match the pinhole model K exactly.
+
+    Pixel u (OpenCV: centre at integer u) is window x = u + 0.5; pybullet flips rows, so image row v
+    is window y = height - v - 0.5. Solving NDC = f(K) for both gives the principal-point terms.
+    """
+    fx, fy, cx, cy = K[0, 0], K[1, 1], K[0, 2], K[1, 2]
+    return np.array([
+        [2 * fx / width, 0.0, 1 - (2 * cx + 1) / width, 0.0],
+        [0.0, 2 * fy / height, (2 * cy + 1) / height - 1, 0.0],
+        [0.0, 0.0, -(far + near) / (far - near), -2 * far * near / (far - near)],
+        [0.0, 0.0, -1.0, 0.0]])
+
+
+def view_matrix(position: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """OpenGL view matrix (row-major 4x4) of an optical frame (rotation columns = x right, y down, z fwd)."""
+    eye = rotation @ OPTICAL_TO_GL                 # eye-frame axes in the house frame
+    view = np.eye(4)
+    view[:3, :3] = eye.T
+    view[:3, 3] = -eye.T @ position
+    return view
+
+
+def write_capture(camera: SmartCamera, capture: Capture, directory: Path) -> list[Path]:
+    """rgb.png, depth.png (16-bit millimetres, 0 = no depth), mask.png (instance colours) and
+    info.json (K, poses, the instances in view with their pixel counts) in ``directory``."""
+    directory.mkdir(parents=True, exist_ok=True)
+    paths = [directory / name for name in ("rgb.png", "depth.png", "mask.png", "info.json")]
+    cv2.imwrite(str(paths[0]), cv2.cvtColor(capture.rgb, cv2.COLOR_RGB2BGR))
+    millimetres = np.nan_to_num(capture.depth * 1000.0, nan=0.0, posinf=0.0, neginf=0.0)
+    cv2.imwrite(str(paths[1]), np.clip(np.round(millimetres), 0, 65535).astype(np.uint16))
+    cv2.imwrite(str(paths[2]), cv2.cvtColor(camera.instance_color(capture), cv2.COLOR_RGB2BGR))
+    counts = np.bincount(capture.instance.ravel())
+    by_id = {inst.id: inst for inst in camera.world.instances}
+    visible = [{"id": int(i), "name": by_id[i].name, "kind": by_id[i].kind, "type": by_id[i].type,
+                "room": by_id[i].room, "mask_color": list(by_id[i].mask_color), "pixels": int(counts[i])}
+               for i in np.argsort(-counts) if i in by_id and counts[i] > 0]
+    info = {"house": camera.world.house.number, "renderer": camera.world.renderer,
+            "robot_pose": list(capture.robot_pose), "frame_id": capture.camera_info.frame_id,
+            "camera_position": [float(v) for v in capture.position],
+            "camera_orientation": list(capture.orientation), "K": capture.K.tolist(),
+            "camera_info": asdict(capture.camera_info), "sun_angle": camera.world.settings.sun_angle,
+            "lights_on": sorted(k for k, on in camera.world.settings.lights.items() if on),
+            "depth_png": "uint16 millimetres along the optical axis, 0 = no depth",
+            "instances": visible}
+    paths[3].write_text(json.dumps(info, indent=1) + "\n")
+    return paths

@@ -1,0 +1,75 @@
+"""Helpers for integration tests: run real nodes in subprocesses and watch them with rclpy.
+
+Each test run gets its own ROS_DOMAIN_ID and ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST, so DDS traffic
+stays on this machine and parallel runs do not see each other. Nodes are stopped with SIGINT (SIGKILL
+leaves Fast DDS shared-memory files behind).
+"""
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from typing import Any, Callable
+
+from conftest import ROOT, subprocess_env
+
+DOMAIN_ID = str(10 + os.getpid() % 200)
+
+
+def ros_env(**extra: str) -> dict[str, str]:
+    return subprocess_env(ROS_DOMAIN_ID=DOMAIN_ID, ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+                          PYTHONUNBUFFERED="1", **extra)
+
+
+class NodeProcess:
+    """A ravh node (``ravh NODE ARGS``) in a subprocess, its output kept in a log file."""
+
+    def __init__(self, name: str, *args: str, log_dir: str = "/tmp") -> None:
+        self.log_path = os.path.join(log_dir, f"ravh_{name}_{os.getpid()}_{time.monotonic_ns()}.log")
+        self._log = open(self.log_path, "w")
+        self.proc = subprocess.Popen([sys.executable, "-m", "ravh_sim.cli", name, *args], cwd=ROOT,
+                                     env=ros_env(), stdout=self._log, stderr=subprocess.STDOUT)
+
+    def alive(self) -> bool:
+        return self.proc.poll() is None
+
+    def log(self) -> str:
+        if not self._log.closed:
+            self._log.flush()
+        with open(self.log_path) as f:
+            return f.read()
+
+    def stop(self, timeout: float = 20.0) -> int:
+        """SIGINT, wait; returns the exit code (SIGKILL only as a last resort, reported as -9)."""
+        if self.alive():
+            self.proc.send_signal(signal.SIGINT)
+            try:
+                self.proc.wait(timeout)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        self._log.close()
+        return self.proc.returncode
+
+
+def spin_until(node: Any, condition: Callable[[], bool], timeout: float) -> bool:
+    import rclpy
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if condition():
+            return True
+        rclpy.spin_once(node, timeout_sec=0.05)
+    return condition()
+
+
+def start_rclpy() -> None:
+    """rclpy in the test process, on the test run's domain, with the nodes' DDS transport profile."""
+    import rclpy
+
+    from ravh_sim.nodes.common import use_large_message_transport
+    os.environ.update(ROS_DOMAIN_ID=DOMAIN_ID, ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
+    use_large_message_transport()
+    if not rclpy.ok():
+        rclpy.init()

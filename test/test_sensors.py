@@ -1,0 +1,480 @@
+"""Smart camera, laser scanner, lighting and appearance managers, checked against known geometry.
+
+Most tests use a synthetic two-room house whose every wall is known: room A is [0, 6] x [0, 4],
+room B is [6.2, 9] x [0, 4], a 1 m doorway joins them at x = 6.1, y in [1, 2]. Floors at z = 0.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
+
+import cv2
+import numpy as np
+import pybullet as pb
+import pytest
+
+from ravh_sim.cli import main
+from ravh_sim.errors import UserError
+from ravh_sim.robot.profile import load_profile
+from ravh_sim.sensors.camera import CameraOptions, SmartCamera, projection_from_K
+from ravh_sim.sensors.imaging import encode_jpeg, jpeg_roundtrip
+from ravh_sim.sensors.laser import Laser
+from ravh_sim.world.appearance import Appearance, sun_light
+from ravh_sim.world.footprint import make_footprint
+from ravh_sim.world.house import HOUSE_FORMAT, house_from_dict
+from ravh_sim.world.scene import DOOR_LEAF_THICKNESS, World
+from ravh_sim.world.settings import load_settings, resolve
+
+PROFILE = load_profile("giraff")
+WALL = 0.1
+ROOM_A = (0.0, 0.0, 6.0, 4.0)
+DOOR_Y = (1.0, 2.0)
+CEILING = 2.8
+
+
+# ----------------------------------------------------------------------------- the synthetic house
+
+def _walls(room: str, x0: float, y0: float, x1: float, y1: float, gap_east=None, gap_west=None) -> list:
+    """Four walls just outside a rectangle; an optional doorway (y range) in the east or west wall."""
+    h = WALL / 2
+    out = [{"room": room, "kind": "wall", "a": [x0 - WALL, y0 - h], "b": [x1 + WALL, y0 - h]},
+           {"room": room, "kind": "wall", "a": [x0 - WALL, y1 + h], "b": [x1 + WALL, y1 + h]}]
+    for x, gap in ((x1 + h, gap_east), (x0 - h, gap_west)):
+        if gap is None:
+            out.append({"room": room, "kind": "wall", "a": [x, y0 - WALL], "b": [x, y1 + WALL]})
+        else:
+            out += [{"room": room, "kind": "wall", "a": [x, y0 - WALL], "b": [x, gap[0]]},
+                    {"room": room, "kind": "wall", "a": [x, gap[1]], "b": [x, y1 + WALL]},
+                    {"room": room, "kind": "lintel", "a": [x, gap[0]], "b": [x, gap[1]], "z0": 2.1}]
+    for w in out:
+        w.setdefault("z0", 0.0)
+        w.update(thickness=WALL, z1=CEILING)
+    return out
+
+
+def _object(oid: str, otype: str, room: str, position, size, yaw=0.0, prefab=None) -> dict:
+    return {"id": oid, "type": otype, "tags": [otype], "room": room, "prefab": prefab or otype, "yaw": yaw,
+            "size_estimated": False, "default_model": 0, "inherits_model_from": None,
+            "models": [{"position": list(position), "size": list(size)}]}
+
+
+def _box_house():
+    rect = lambda x0, y0, x1, y1: [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]  # noqa: E731
+    data = {
+        "format": HOUSE_FORMAT, "house": 99,
+        "rooms": [{"id": "A", "type": "LivingRoom", "name": "A", "floor": rect(*ROOM_A),
+                   "floor_z": 0.0, "ceiling_z": CEILING},
+                  {"id": "B", "type": "Bedroom", "name": "B", "floor": rect(6.2, 0.0, 9.0, 4.0),
+                   "floor_z": 0.0, "ceiling_z": CEILING}],
+        "walls": _walls("A", *ROOM_A, gap_east=DOOR_Y) + _walls("B", 6.2, 0.0, 9.0, 4.0, gap_west=DOOR_Y),
+        "doors": [{"id": "Door_0", "rooms": ["A", "B"], "position": [6.1, 1.5, 1.05], "yaw": math.pi / 2,
+                   "width": 1.0, "height": 2.1, "thickness": 0.2, "leaf": [0.9, 0.05, 2.05],
+                   "default_open": True}],
+        "windows": [{"id": "Wall_0", "room": "A", "position": [-0.05, 2.0, 1.5], "yaw": -math.pi / 2,
+                     "width": 1.2, "height": 1.0, "thickness": 0.17}],
+        "lights": [{"id": "Light_0", "kind": "ceiling", "room": "A", "position": [3.0, 2.0, 2.65],
+                    "intensity": 1.0, "range": 10.0, "color": [1.0, 0.8, 0.45]},
+                   {"id": "Light_1", "kind": "ceiling", "room": "B", "position": [7.6, 2.0, 2.65],
+                    "intensity": 1.0, "range": 10.0, "color": [1.0, 0.8, 0.45]}],
+        "objects": [_object("Door_0", "Door", "A", (6.1, 1.5, 1.05), (0.2, 1.0, 2.1)),
+                    _object("Wall_0", "Wall", "A", (-0.05, 2.0, 1.5), (1.2, 0.17, 1.0), -math.pi / 2, "Window"),
+                    _object("Light_0", "Light", "A", (3.0, 2.0, 2.75), (0.36, 0.36, 0.08)),
+                    _object("Light_1", "Light", "B", (7.6, 2.0, 2.75), (0.36, 0.36, 0.08)),
+                    _object("Closet_0", "Closet", "B", (8.6, 3.0, 1.0), (0.6, 1.2, 2.0)),
+                    _object("Station_0", "Station", "A", (1.0, 0.5, 0.01), (0.5, 0.5, 0.02))],
+        "station": {"position": [1.0, 0.5, 0.0], "yaw": 0.0, "object_id": "Station_0"},
+    }
+    return house_from_dict(data, "synthetic")
+
+
+@pytest.fixture(scope="module")
+def box_house():
+    return _box_house()
+
+
+def _world(house, renderer="auto", seed=0):
+    return World(house, resolve(load_settings(), house, seed), renderer=renderer)
+
+
+@pytest.fixture(scope="module")
+def world(box_house):
+    with _world(box_house) as w:
+        yield w
+
+
+@pytest.fixture()
+def appearance(world):
+    """Run-time appearance manager; restores the world's settings after each test."""
+    app = Appearance(world)
+    before = resolve(load_settings(), world.house, 0)
+    yield app
+    app.apply(before)
+
+
+@pytest.fixture(scope="module")
+def camera(world):
+    return SmartCamera(world, PROFILE.camera)
+
+
+def _ids(world, kind=None, name=None):
+    return {i.id for i in world.instances if (kind is None or i.kind == kind) and (name is None or i.name == name)}
+
+
+# ----------------------------------------------------------------------------- camera geometry
+
+def test_K_follows_the_paper_formula(camera):
+    spec = PROFILE.camera
+    fx, fy = spec.focal_length * spec.width / spec.sensor_width, spec.focal_length * spec.height_px / spec.sensor_height
+    assert camera.K == pytest.approx(np.array([[fx, 0, 320.0], [0, fy, 240.0], [0, 0, 1]]))
+    assert fx == pytest.approx(548.571, abs=1e-3) and fy == pytest.approx(568.421, abs=1e-3)
+    info = camera.camera_info
+    assert info.distortion_model == "plumb_bob" and info.D == (0.0,) * 5
+    assert info.P == pytest.approx((fx, 0, 320, 0, 0, fy, 240, 0, 0, 0, 1, 0))
+    assert (info.width, info.height) == (640, 480)
+
+
+def test_projection_matrix_maps_K_pixels_to_ndc():
+    K = np.array([[500.0, 0, 300.0], [0, 520.0, 200.0], [0, 0, 1]])
+    proj = projection_from_K(K, 640, 480, 0.1, 10.0)
+    point = np.array([0.3, -0.2, 2.5])                         # optical frame: x right, y down, z fwd
+    u, v = (K @ point)[:2] / point[2]
+    clip = proj @ np.array([point[0], -point[1], -point[2], 1.0])   # GL eye frame
+    ndc = clip[:3] / clip[3]
+    assert (ndc[0] + 1) * 640 / 2 - 0.5 == pytest.approx(u)       # window x = u + 0.5
+    assert 480 - (ndc[1] + 1) * 480 / 2 - 0.5 == pytest.approx(v)  # image rows run down
+    assert ndc[2] == pytest.approx((1 / 0.1 - 1 / 2.5) / (1 / 0.1 - 1 / 10.0) * 2 - 1)
+
+
+def test_points_projected_with_K_land_where_they_render(camera, world):
+    x, y, yaw = 2.0, 3.0, 0.0
+    cap = camera.capture(x, y, yaw)
+    walls, floors = _ids(world, "walls", "A/walls"), _ids(world, "floor", "A/floor")
+    # The line where room A's floor meets its east wall (x = 6), at y = 3.3: wall above, floor below.
+    u, v = camera.project(np.array([[6.0, 3.3, 0.0]]), x, y, yaw)[0]
+    col = cap.instance[:, int(round(u))]
+    boundary = np.flatnonzero(np.isin(col[:-1], list(walls)) & np.isin(col[1:], list(floors)))
+    assert len(boundary) == 1 and abs(boundary[0] + 0.5 - v) <= 1.0
+    # The doorway's jamb at y = 2: room A's wall piece ends at x = 6.1 where room B's begins.
+    x, y, yaw = 2.0, 1.5, 0.0
+    cap = camera.capture(x, y, yaw)
+    u, v = camera.project(np.array([[6.1, 2.0, 1.0]]), x, y, yaw)[0]
+    row = cap.instance[int(round(v))]
+    a_walls, b_walls = world.instance("A/walls").id, world.instance("B/walls").id
+    edges = np.flatnonzero((row[:-1] == a_walls) & (row[1:] == b_walls))
+    assert len(edges) == 1 and abs(edges[0] + 0.5 - u) <= 1.0
+
+
+def _plane_depth(camera, x, y, yaw, row, plane_x=6.0):
+    """Expected z-depth along image ``row`` of the vertical plane x = plane_x."""
+    position, rotation = camera.optical_pose(x, y, yaw)
+    us = np.arange(camera.width)
+    rays = np.stack([(us - camera.K[0, 2]) / camera.K[0, 0], np.full(len(us), (row - camera.K[1, 2]) / camera.K[1, 1]),
+                     np.ones(len(us))])
+    return (plane_x - position[0]) / (rotation @ rays)[0]
+
+
+def test_depth_of_a_wall_is_z_depth_within_a_centimetre(camera, world):
+    x, y, yaw = 2.0, 0.6, 0.0                          # facing the east wall below the doorway
+    cap = camera.capture(x, y, yaw)
+    expected = _plane_depth(camera, x, y, yaw, 240)
+    position, rotation = camera.optical_pose(x, y, yaw)
+    rays = np.linalg.inv(camera.K) @ np.stack([np.arange(640), np.full(640, 240), np.ones(640)])
+    hit_y = position[1] + expected * (rotation @ rays)[1]           # where each pixel meets x = 6
+    east = (hit_y > 0.02) & (hit_y < DOOR_Y[0] - 0.02)
+    row = cap.depth[240]
+    assert east[300:340].all() and east.sum() > 100
+    assert (cap.instance[240][east] == world.instance("A/walls").id).all()
+    assert np.abs(row[east] - expected[east]).max() < 0.01
+    axis = (6.0 - position[0]) / math.cos(math.radians(PROFILE.camera.pitch_deg))
+    assert row[320] == pytest.approx(axis, abs=0.01)   # z-depth on the optical axis
+    assert abs(row[east].max() - row[320]) < 0.01      # z-depth, not ray length: flat across
+
+
+def test_nothing_hit_is_nan_and_instance_zero(camera):
+    cap = camera.capture(3.0, 2.0, math.pi)
+    up = SmartCamera(camera.world, replace(PROFILE.camera, pitch_deg=-80.0)).capture(3.0, 2.0, 0.0, floor_z=10.0)
+    assert np.isfinite(cap.depth).all() and (cap.instance > 0).all()
+    assert np.isnan(up.depth).mean() > 0.9 and (up.instance[np.isnan(up.depth)] == 0).all()
+
+
+def test_object_straight_ahead_is_the_most_frequent_instance_at_the_centre(camera, world):
+    cap = camera.capture(6.8, 3.0, 0.0)
+    patch = cap.instance[230:250, 310:330]
+    assert np.bincount(patch.ravel()).argmax() == world.instance("Closet_0").id
+
+
+def test_camera_pose_is_the_pitched_optical_frame(camera):
+    position, quat = camera.camera_pose(1.0, 2.0, math.pi / 2)
+    spec = PROFILE.camera
+    assert position == pytest.approx((1.0, 2.0 + spec.forward, spec.height))
+    rot = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
+    pitch = math.radians(spec.pitch_deg)
+    assert rot[:, 2] == pytest.approx([0.0, math.cos(pitch), -math.sin(pitch)], abs=1e-9)   # z forward
+    assert rot[:, 0] == pytest.approx([1.0, 0.0, 0.0], abs=1e-9)                           # x right
+
+
+def test_instance_colours_use_the_footprint_mask_colours(camera, world, box_house):
+    cap = camera.capture(6.8, 3.0, 0.0)
+    colours = camera.instance_color(cap)
+    rows = {r["id"]: tuple(r["mask_color"]) for r in make_footprint(box_house, world.settings)["instances"]}
+    v, u = 240, 320
+    assert tuple(colours[v, u]) == rows[int(cap.instance[v, u])]
+
+
+# ----------------------------------------------------------------------------- laser
+
+def _room_distance(x, y, angle, x0=0.0, y0=0.0, x1=6.0, y1=4.0):
+    c, s = math.cos(angle), math.sin(angle)
+    ts = [t for t in ((x1 - x) / c if c > 1e-12 else math.inf, (x0 - x) / c if c < -1e-12 else math.inf,
+                      (y1 - y) / s if s > 1e-12 else math.inf, (y0 - y) / s if s < -1e-12 else math.inf)]
+    return min(ts)
+
+
+def test_laser_ranges_match_the_walls_within_a_centimetre(world):
+    laser = Laser(world, PROFILE.laser)
+    x, y, yaw = 2.0, 2.5, 0.3
+    scan = laser.scan(x, y, yaw)
+    checked = 0
+    for i, r in enumerate(scan.ranges):
+        angle = scan.angle_min + i * scan.angle_increment + yaw
+        expected = _room_distance(x, y, angle)
+        hit_y = y + expected * math.sin(angle)
+        if abs(x + expected * math.cos(angle) - 6.0) < 1e-6 and DOOR_Y[0] - 0.05 <= hit_y <= DOOR_Y[1] + 0.05:
+            continue                                   # through the doorway
+        assert r == pytest.approx(expected, abs=0.01), i
+        checked += 1
+    assert checked > 340
+
+
+def test_rep117_counting_and_infinities(world):
+    full = Laser(world, PROFILE.laser)
+    assert len(full.angles) == 360
+    assert full.angle_min == pytest.approx(-math.pi)
+    assert full.angle_max == pytest.approx(-math.pi + 359 * full.angle_increment)
+    fan = Laser(world, replace(PROFILE.laser, fov_deg=270.0))
+    scan = fan.scan(2.0, 2.5, 0.0)
+    assert len(scan.ranges) == round((scan.angle_max - scan.angle_min) / scan.angle_increment) + 1 == 271
+    assert (scan.angle_min, scan.angle_max) == pytest.approx((-3 * math.pi / 4, 3 * math.pi / 4))
+    short = Laser(world, replace(PROFILE.laser, range_max=3.0)).scan(2.0, 2.5, 0.0)
+    assert short.ranges[180] == np.inf                 # the east wall is 4 m ahead
+    assert short.ranges[270] == pytest.approx(1.5, abs=0.01)
+    near = Laser(world, replace(PROFILE.laser, range_min=2.2)).scan(2.0, 2.5, 0.0)
+    assert near.ranges[0] == -np.inf                   # the west wall is 2 m behind
+    assert near.ranges[180] == pytest.approx(4.0, abs=0.01)
+    assert scan.scan_time == pytest.approx(1 / PROFILE.laser.rate)
+    assert scan.time_increment == pytest.approx(scan.scan_time / 271)
+
+
+def test_laser_sees_past_ignored_bodies(world):
+    """A robot part in front of the laser (a bumper, a mast) must not shadow the scan when ignored.
+    (Rays that start inside a convex body do not hit it, so a body around the laser never does.)"""
+    laser = Laser(world, PROFILE.laser)
+    clear = laser.scan(2.0, 2.5, 0.0)
+    shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[0.05, 0.3, 0.5], physicsClientId=world.client)
+    body = pb.createMultiBody(0, shape, -1, basePosition=[2.35, 2.5, 0.5], physicsClientId=world.client)
+    try:
+        blocked = laser.scan(2.0, 2.5, 0.0)
+        ignored = laser.scan(2.0, 2.5, 0.0, ignore_bodies=[body])
+    finally:
+        pb.removeBody(body, physicsClientId=world.client)
+    assert blocked.ranges[180] == pytest.approx(0.3, abs=0.01) and (blocked.hit_bodies == body).sum() > 40
+    assert ignored.ranges == pytest.approx(clear.ranges, abs=1e-4)
+
+
+def test_closing_a_door_changes_laser_and_depth_in_the_doorway(world, camera, appearance):
+    laser = Laser(world, PROFILE.laser)
+    pose = (3.0, 1.5, 0.0)
+    open_scan, open_cap = laser.scan(*pose), camera.capture(*pose)
+    appearance.set_door("Door_0", False)
+    closed_scan, closed_cap = laser.scan(*pose), camera.capture(*pose)
+    assert open_scan.ranges[180] == pytest.approx(6.0, abs=0.01)            # room B's far wall
+    assert closed_scan.ranges[180] == pytest.approx(3.1 - 0.05, abs=0.01)   # the leaf's collision box
+    door = world.instance("Door_0").id
+    assert (open_cap.instance == door).mean() < 0.01 < (closed_cap.instance == door).mean()
+    position, _ = camera.optical_pose(*pose)
+    along_x = math.cos(math.radians(PROFILE.camera.pitch_deg))       # optical axis: x per metre of depth
+    leaf_x = position[0] + closed_cap.depth[240, 320] * along_x
+    assert 6.1 - DOOR_LEAF_THICKNESS <= leaf_x <= 6.1 + DOOR_LEAF_THICKNESS   # on the leaf model
+    assert closed_cap.instance[240, 320] == door
+    assert position[0] + open_cap.depth[240, 320] * along_x > 8.0            # into room B
+    assert world.settings.doors["Door_0"] is False
+
+
+# ----------------------------------------------------------------------------- appearance and lighting
+
+def _mean(img, mask=None):
+    return float(img[mask].mean() if mask is not None else img.mean())
+
+
+def test_day_is_brighter_than_sunset_is_brighter_than_night(camera, appearance):
+    means = {}
+    for preset in ("day", "sunset", "night"):
+        appearance.set_sun(preset)
+        means[preset] = _mean(camera.capture(3.0, 2.0, math.pi).rgb)
+    assert means["day"] > 1.2 * means["sunset"] > 1.2 * 1.5 * means["night"]
+    assert sun_light(180).gain[0] > sun_light(180).gain[2]          # sunset light is warm
+    assert sun_light(200).gain[2] > sun_light(200).gain[0]          # night is blue
+
+
+def test_lights_on_brighten_their_room_at_night_and_not_the_other(camera, world, appearance):
+    appearance.set_sun("night")
+    appearance.set_lights("all", "off")
+    pose = (3.0, 1.5, 0.0)                            # room A, looking through the door into room B
+    dark = camera.capture(*pose)
+    appearance.set_light("Light_0", True)
+    lit = camera.capture(*pose)
+    room_a = np.isin(dark.instance, list({i.id for i in world.instances if i.room == "A"}))
+    room_b = np.isin(dark.instance, list({i.id for i in world.instances if i.room == "B"}))
+    assert room_a.mean() > 0.5 and room_b.mean() > 0.01
+    assert _mean(lit.rgb, room_a) > 3 * _mean(dark.rgb, room_a)
+    assert np.array_equal(lit.rgb[room_b], dark.rgb[room_b])          # no light through the wall
+
+
+def test_paint_changes_wall_pixel_colour(camera, world, appearance):
+    walls = world.instance("A/walls").id
+    appearance.set_paint("A", "walls", "terracotta")
+    warm = camera.capture(2.0, 0.6, 0.0)
+    appearance.set_paint("A", "walls", "sky")
+    cool = camera.capture(2.0, 0.6, 0.0)
+    w = warm.instance == walls
+    assert w.mean() > 0.3
+    r_warm, _, b_warm = warm.rgb[w].mean(axis=0)
+    r_cool, _, b_cool = cool.rgb[w].mean(axis=0)
+    assert r_warm > b_warm + 40 and b_cool > r_cool + 20
+    assert world.settings.paint["A"]["walls"] == "sky"
+    with pytest.raises(UserError):
+        appearance.set_paint("A", "walls", "plaid")
+
+
+def test_swapping_an_object_model_changes_its_pixels(camera, world, appearance):
+    closet = world.instance("Closet_0").id
+    before = camera.capture(6.8, 3.0, 0.0)
+    assert appearance.set_object_model("Closet_0", 1) == 1
+    after = camera.capture(6.8, 3.0, 0.0)
+    both = (before.instance == closet) & (after.instance == closet)
+    diff = np.abs(before.rgb.astype(int) - after.rgb.astype(int)).sum(axis=2)
+    assert both.mean() > 0.2 and (diff[both] > 20).mean() > 0.05
+    assert world.settings.models["Closet_0"] == 1
+    assert make_footprint(world.house, world.settings)["settings"]["models"]["Closet_0"] == 1
+
+
+def test_model_choices_random_and_inherit(world, appearance):
+    picked = appearance.set_object_model("Closet_0", "random", seed=4)
+    settings = load_settings()
+    settings["models"]["set"] = {"Closet_0": "random"}
+    assert picked == resolve(settings, world.house, 4).models["Closet_0"]
+    appearance.set_object_model("Light_0", 2)
+    assert appearance.set_object_model("Light_1", {"inherit": "Light_0"}) == 2
+    with pytest.raises(UserError):
+        appearance.set_object_model("Closet_0", 99)
+
+
+def test_randomise_changes_settings_and_world_together(world, appearance):
+    target = appearance.randomise(seed=3)
+    again = resolve(load_settings(), world.house, 0)
+    assert target is world.settings
+    assert target.paint != again.paint or target.models != again.models or target.lights != again.lights
+    assert 0.0 <= target.sun_angle <= 240.0
+    fp = make_footprint(world.house, world.settings)
+    assert fp["settings"]["paint"] == target.paint
+
+
+def test_window_shows_the_sky(camera, world, appearance):
+    window = world.instance("Wall_0").id
+    for preset in ("day", "night"):
+        appearance.set_sun(preset)
+        cap = camera.capture(3.0, 2.0, math.pi)
+        pane = cap.instance == window
+        assert pane.mean() > 0.03
+        sky = np.array(sun_light(world.settings.sun_angle).sky)
+        assert (np.abs(cap.rgb[pane].astype(int) - sky).max(axis=1) == 0).mean() > 0.6
+        assert np.isfinite(cap.depth[pane]).all()          # the glass is in the wall: depth stays
+
+
+# ----------------------------------------------------------------------------- determinism, renderers
+
+def test_same_seed_and_pose_give_identical_images_and_scans(box_house):
+    options = CameraOptions(pixel_noise=3.0, depth_noise=0.002)
+    laser_spec = replace(PROFILE.laser, noise_sigma=0.01)
+    runs = []
+    for seed in (5, 5, 6):
+        with _world(box_house, "tiny", seed) as w:
+            cam, laser = SmartCamera(w, PROFILE.camera, options), Laser(w, laser_spec)
+            runs.append([(cam.capture(2.0, 2.0, 0.3), laser.scan(2.0, 2.0, 0.3)) for _ in range(2)])
+    (a1, s1), (a2, s2) = runs[0]
+    (b1, t1), _ = runs[1]
+    (c1, u1), _ = runs[2]
+    assert np.array_equal(a1.rgb, b1.rgb) and np.array_equal(a1.depth, b1.depth, equal_nan=True)
+    assert np.array_equal(s1.ranges, t1.ranges)
+    assert not np.array_equal(a1.rgb, a2.rgb) and not np.array_equal(s1.ranges, s2.ranges)   # new frame
+    assert not np.array_equal(a1.rgb, c1.rgb) and not np.array_equal(s1.ranges, u1.ranges)   # new seed
+
+
+def test_tiny_renderer_fallback_gives_a_similar_image(box_house, camera):
+    pose = (3.0, 1.5, 0.3)
+    egl = camera.capture(*pose)
+    with _world(box_house, "tiny") as w:
+        assert w.renderer == "tiny"
+        tiny = SmartCamera(w, PROFILE.camera).capture(*pose)
+    assert (egl.instance == tiny.instance).mean() > 0.97
+    both = np.isfinite(egl.depth) & np.isfinite(tiny.depth)
+    assert np.median(np.abs(egl.depth[both] - tiny.depth[both])) < 0.01
+    assert abs(_mean(egl.rgb) - _mean(tiny.rgb)) < 15
+
+
+# ----------------------------------------------------------------------------- optics
+
+def test_distortion_moves_pixels_as_cv2_projects_them(world, camera):
+    coefficients = (-0.25, 0.08, 0.001, -0.001, 0.0)
+    bent = SmartCamera(world, PROFILE.camera, CameraOptions(distortion=coefficients))
+    assert bent.camera_info.D == coefficients
+    x, y, yaw = 2.0, 3.0, 0.0
+    cap = bent.capture(x, y, yaw)
+    position, rotation = bent.optical_pose(x, y, yaw)
+    point = np.array([6.0, 3.3, 0.0])                 # floor meets the east wall
+    cam_point = (point - position) @ rotation
+    (u, v), = cv2.projectPoints(cam_point[None], np.zeros(3), np.zeros(3), bent.K, np.array(coefficients))[0][:, 0]
+    col = cap.instance[:, int(round(u))]
+    walls, floors = world.instance("A/walls").id, world.instance("A/floor").id
+    boundary = np.flatnonzero((col[:-1] == walls) & (col[1:] == floors))
+    assert len(boundary) == 1 and abs(boundary[0] + 0.5 - v) <= 1.5
+    straight = camera.capture(x, y, yaw)
+    assert not np.array_equal(straight.instance, cap.instance)
+
+
+def test_motion_blur_follows_turning_speed(world):
+    blurry = SmartCamera(world, PROFILE.camera, CameraOptions(motion_blur=True, exposure=0.03))
+    still = blurry.capture(3.0, 2.0, math.pi, velocity=(0.0, 0.0))
+    turning = blurry.capture(3.0, 2.0, math.pi, velocity=(0.0, 1.0))     # ~16 px sweep
+
+    def energy(img, axis):
+        return float((np.diff(cv2.cvtColor(img, cv2.COLOR_RGB2GRAY).astype(float), axis=axis) ** 2).mean())
+    assert energy(turning.rgb, 1) < 0.5 * energy(still.rgb, 1)            # sideways detail smeared
+    assert energy(turning.rgb, 0) > 0.5 * energy(still.rgb, 0)            # vertical detail mostly kept
+
+
+def test_jpeg_helpers(camera):
+    rgb = camera.capture(3.0, 2.0, math.pi).rgb
+    data = encode_jpeg(rgb, 80)
+    assert data[:2] == b"\xff\xd8" and len(data) < rgb.nbytes / 5
+    back = jpeg_roundtrip(rgb, 80)
+    assert back.shape == rgb.shape and 0 < np.abs(back.astype(int) - rgb).mean() < 5
+
+
+# ----------------------------------------------------------------------------- CLI
+
+def test_render_command_writes_images_and_info(tmp_path, capsys):
+    out = tmp_path / "view"
+    assert main(["render", "15", "--pose", "8.41", "-4.75", "1.5708", "--sun", "night", "--lights", "on",
+                 "--renderer", "tiny", "-o", str(out)]) == 0
+    depth = cv2.imread(str(out / "depth.png"), cv2.IMREAD_UNCHANGED)
+    assert depth.dtype == np.uint16 and depth.shape == (480, 640) and 300 < np.median(depth) < 20000
+    mask = cv2.imread(str(out / "mask.png"))
+    info = json.loads((out / "info.json").read_text())
+    assert info["K"][0][0] == pytest.approx(548.571, abs=1e-3) and info["sun_angle"] == 200.0
+    assert sum(i["pixels"] for i in info["instances"]) == 640 * 480
+    top = info["instances"][0]
+    assert (mask[:, :, ::-1].reshape(-1, 3) == top["mask_color"]).all(axis=1).sum() == top["pixels"]
+    assert main(["render", "15", "--pose", "0", "0", "0", "--sun", "noon", "-o", str(out)]) == 2
+    assert "sun preset" in capsys.readouterr().err
