@@ -87,12 +87,14 @@ def obstacles(house: House, door_open: Mapping[str, bool], models: Mapping[str, 
 
 
 def inflate(grid: Grid, radius: float) -> Grid:
-    """A copy of ``grid`` where FREE cells whose centre lies within ``radius`` of the centre of any
-    non-FREE cell (OCCUPIED or UNKNOWN: the robot must not leave the house either) are OCCUPIED."""
+    """A copy of ``grid`` where FREE cells whose centre lies within ``radius`` of any non-FREE cell
+    (OCCUPIED or UNKNOWN: the robot must not leave the house either) are OCCUPIED. Distances are
+    taken to the obstacle cell's near edge (centre distance minus half a cell), so a robot centred on
+    a free cell clears the obstacle's area, not just its centre."""
     if radius < 0:
         raise ValueError(f"radius must be >= 0, got {radius}")
     data = grid.data.copy()
-    within = _distance_cells(grid.data) <= radius / grid.resolution + 1e-6
+    within = _distance_cells(grid.data) - 0.5 <= radius / grid.resolution + 1e-6
     data[(data == FREE) & within] = OCCUPIED
     return Grid(data, grid.origin, grid.resolution)
 
