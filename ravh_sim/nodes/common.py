@@ -48,7 +48,11 @@ def run_node(make_node: Callable[[list[str]], object], argv: list[str] | None = 
     node = None
     try:
         node = make_node(rclpy.utilities.remove_ros_args(args)[1:])
-        rclpy.spin(node)
+        finished = getattr(node, "finished", None)        # behaviours that end complete this future
+        if finished is not None:
+            rclpy.spin_until_future_complete(node, finished)
+        else:
+            rclpy.spin(node)
     except UserError as e:
         print(f"ravh: error: {e}", file=sys.stderr)
         return 2

@@ -6,6 +6,9 @@ import sys
 
 NODES = {
     "sim": "ravh_sim.nodes.sim_node",
+    "wanderer": "ravh_sim.nodes.wanderer_node",
+    "grid": "ravh_sim.nodes.grid_node",
+    "teleop": "ravh_sim.nodes.teleop_node",
 }
 
 

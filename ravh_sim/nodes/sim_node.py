@@ -231,8 +231,10 @@ class SimNode(Node):
             scan.ranges, scan.angle_min, scan.angle_increment, scan.range_min, scan.range_max,
             scan.scan_time, hdr))
 
-    def _publish_capture(self, agent: Agent) -> dict[str, Any]:
-        """One synchronised capture: RGB, JPEG, depth, instances and both camera_infos share one stamp."""
+    def _publish_capture(self, agent: Agent, requested: bool = False) -> dict[str, Any]:
+        """One synchronised capture: RGB, JPEG, depth, instances and both camera_infos share one stamp.
+        A requested capture (the capture service) adds a scan with that stamp and an event on
+        ravh/capture (pose, room) so recorders can store it as one dataset sample."""
         rt, pubs = self.runtime, self.agent_pubs[agent.name]
         cap = rt.capture(agent)
         hdr = convert.header(rt.time, self._frame(agent, n.CAMERA_OPTICAL_FRAME))
@@ -247,7 +249,9 @@ class SimNode(Node):
         x, y, yaw = agent.robot.pose
         event = {"agent": agent.name, "stamp": rt.time, "pose": [x, y, yaw], "room": rt.room_of(agent),
                  "odom": list(agent.robot.odometry)}
-        pubs["capture"].publish(String(data=json.dumps(event)))
+        if requested:
+            self._publish_scan(agent)
+            pubs["capture"].publish(String(data=json.dumps(event)))
         return event
 
     # ------------------------------------------------------------------ callbacks
@@ -312,7 +316,7 @@ class SimNode(Node):
 
     def _on_capture(self, agent: Agent, response: Trigger.Response):
         try:
-            event = self._publish_capture(agent)
+            event = self._publish_capture(agent, requested=True)
             response.success, response.message = True, json.dumps(event)
         except Exception as e:  # never die from a request
             response.success, response.message = False, f"{type(e).__name__}: {e}"

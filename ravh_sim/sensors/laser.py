@@ -1,10 +1,11 @@
 """The laser scanner: one horizontal fan of rays through pybullet's collision world (REP 117 ranges).
 
-All rays go out in one ``rayTestBatch`` from the laser height. Ranges follow REP 117: +inf where
-nothing is hit within ``range_max``, -inf where the hit is closer than ``range_min``. The robot's own
-body must not shadow the scan, but a batch cannot skip bodies: rays whose first hit is an ignored
-body are cast again (one more batch for just those rays) from where they leave that body's bounding
-box, so a scan costs one batch when nothing is ignored. Open doors are moved out of the house by the
+Rays go out from the laser height in a few ``rayTestBatch`` calls of growing length (see
+:meth:`Laser._trace`). Ranges follow REP 117: +inf where nothing is hit within ``range_max``, -inf
+where the hit is closer than ``range_min``. The robot's own body must not shadow the scan, but a
+batch cannot skip bodies: rays whose first hit is an ignored body are cast again from where they
+leave that body's bounding box. (Rays that start inside a convex body never hit it, so a body
+around the laser needs no ignoring; a bumper or mast in front of it does.) Open doors are moved out of the house by the
 World, so the laser sees through open doorways; closed doors, walls and furniture stop it. Noise is
 Gaussian, seeded from the world seed and a scan counter.
 """
@@ -22,7 +23,10 @@ from ravh_sim.sensors.mount import LASER_FRAME, floor_at
 from ravh_sim.world.scene import World
 
 NOISE_STREAM = 2            # noise generator stream of lasers (cameras use another)
+STAGES = (1.5, 4.0, 10.0)   # m: ray lengths of the first cast stages (then range_max)
+STAGE_OVERLAP = 0.01        # m: a stage starts this much before the previous one ended
 RECAST_GAP = 1e-3           # m beyond an ignored body's box where a re-cast ray starts
+MAX_RECASTS = 8             # per stage: ignored bodies a ray may pass
 
 
 @dataclass
@@ -65,17 +69,7 @@ class Laser:
         z = (floor_at(self.world, x, y) if floor_z is None else floor_z) + spec.height
         directions = np.stack([np.cos(self.angles + yaw), np.sin(self.angles + yaw),
                                np.zeros(len(self.angles))], axis=1)
-        origin = np.array([x, y, z])
-        starts = np.broadcast_to(origin, directions.shape)
-        ends = origin + directions * spec.range_max
-        bodies, distances = self._cast(starts, ends, directions, origin)
-        ignored = np.isin(bodies, list(ignore_bodies))
-        if ignored.any():
-            exits = np.array([_box_exit(origin, d, pb.getAABB(int(b), physicsClientId=self.world.client))
-                              for d, b in zip(directions[ignored], bodies[ignored])]) + RECAST_GAP
-            again = origin + directions[ignored] * np.minimum(exits, spec.range_max)[:, None]
-            b2, d2 = self._cast(again, ends[ignored], directions[ignored], origin)
-            bodies[ignored], distances[ignored] = b2, d2
+        bodies, distances = self._trace(np.array([x, y, z]), directions, set(ignore_bodies))
         ranges = distances.astype(np.float32)
         if spec.noise_sigma > 0:
             rng = np.random.default_rng([self.world.settings.seed, NOISE_STREAM, self.count])
@@ -84,18 +78,45 @@ class Laser:
         ranges[ranges < spec.range_min] = -np.inf
         scan = Scan(LASER_FRAME, self.angle_min, self.angle_max, self.angle_increment,
                     self.scan_time / len(self.angles), self.scan_time, spec.range_min, spec.range_max,
-                    ranges.astype(np.float32), bodies.astype(np.int32), self.count)
+                    ranges, bodies.astype(np.int32), self.count)
         self.count += 1
         return scan
 
-    def _cast(self, starts: np.ndarray, ends: np.ndarray, directions: np.ndarray, origin: np.ndarray
-              ) -> tuple[np.ndarray, np.ndarray]:
-        """(body hit or -1, distance from ``origin`` or +inf) per ray."""
-        hits = pb.rayTestBatch(starts.tolist(), ends.tolist(), physicsClientId=self.world.client)
-        bodies = np.array([h[0] for h in hits], np.int64)
-        points = np.array([h[3] for h in hits], float)
-        distances = np.einsum("ij,ij->i", points - origin, directions)
-        distances[bodies < 0] = np.inf
+    def _trace(self, origin: np.ndarray, directions: np.ndarray, ignore: set[int]
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """(first body hit or -1, its distance or +inf) per ray, skipping ``ignore`` bodies.
+
+        Bullet's ray test walks every bounding box a ray crosses over its whole length, so a scan
+        is cast in growing stages (STAGES, then range_max): a ray that hits something stops, the
+        others go on from where they ended. Indoors most rays stop in the first stages, which
+        halves the cost of one full-length batch. A ray that hits an ignored body starts again
+        just past that body's bounding box.
+        """
+        n = len(directions)
+        bodies, distances = np.full(n, -1, np.int64), np.full(n, np.inf)
+        start = np.zeros(n)                                  # where each ray (re)starts, metres
+        todo = np.arange(n)
+        ends = [e for e in STAGES if e < self.spec.range_max] + [self.spec.range_max]
+        for end in ends:
+            for _ in range(MAX_RECASTS):
+                go = todo[start[todo] < end]
+                if not go.size:
+                    break
+                hits = pb.rayTestBatch(origin + directions[go] * start[go, None], origin + directions[go] * end,
+                                       physicsClientId=self.world.client)
+                body = np.fromiter((h[0] for h in hits), np.int64, len(hits))
+                point = np.array([h[3] for h in hits])
+                skip = np.isin(body, list(ignore)) if ignore else np.zeros(len(go), bool)
+                found = (body >= 0) & ~skip
+                bodies[go[found]] = body[found]
+                distances[go[found]] = np.einsum("ij,ij->i", point[found] - origin, directions[go[found]])
+                start[go[body < 0]] = end - STAGE_OVERLAP
+                for i in np.flatnonzero(skip):
+                    aabb = pb.getAABB(int(body[i]), physicsClientId=self.world.client)
+                    start[go[i]] = _box_exit(origin, directions[go[i]], aabb) + RECAST_GAP
+                todo = todo[~np.isin(todo, go[found])]
+                if not skip.any():
+                    break
         return bodies, distances
 
 

@@ -1,0 +1,183 @@
+"""A behaviour (Wanderer, Grid) as a separate ROS process that only uses the sim node's interface.
+
+The node learns the house from the ground-truth service (rooms, floors, ceiling lights) and /map,
+follows the robot on ground_truth/pose, drives it with cmd_vel and asks for captures through the
+capture service. It runs on sim time, so it keeps pace with a sim that runs faster than real time.
+Every capture it gets back is logged with its pose and room (and written to ``--log`` as JSON lines).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import time
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+from geometry_msgs.msg import PoseStamped, Twist
+from nav_msgs.msg import OccupancyGrid
+from rclpy.node import Node
+from rclpy.task import Future
+from rclpy.parameter import Parameter
+from std_srvs.srv import Trigger
+
+from ravh_msgs_py import names as n
+from ravh_msgs_py.client import RavhClient
+from ravh_sim.behaviours.waypoints import Layout
+from ravh_sim.errors import UserError
+from ravh_sim.nav.follower import PathFollower
+from ravh_sim.nav.grid import Grid
+from ravh_sim.nav.planner import Path as PlannedPath
+from ravh_sim.nav.planner import plan_path
+from ravh_sim.nodes.common import COMMAND_QOS, LATCHED_QOS, STATE_QOS
+from ravh_sim.robot.profile import load_profile
+
+FIRST_AGENT = "robot"            # the default settings' agent; other agents' topics are prefixed
+CONTROL_HZ = 20.0                # sim-time control rate (as nav2's controllers)
+STARTUP_TIMEOUT_S = 60.0
+
+
+class RosRobot:
+    """The robot as the behaviours see it (``pose``, ``set_command``), over ROS topics."""
+
+    def __init__(self, node: Node, agent: str, first: bool) -> None:
+        self._pub = node.create_publisher(Twist, n.agent_name(n.CMD_VEL, agent, first), COMMAND_QOS)
+        self.pose_msg: PoseStamped | None = None
+        node.create_subscription(PoseStamped, n.agent_name(n.GROUND_TRUTH_POSE, agent, first),
+                                 self._on_pose, STATE_QOS)
+
+    def _on_pose(self, msg: PoseStamped) -> None:
+        self.pose_msg = msg
+
+    @property
+    def pose(self) -> tuple[float, float, float]:
+        p = self.pose_msg.pose
+        return (p.position.x, p.position.y, 2.0 * math.atan2(p.orientation.z, p.orientation.w))
+
+    def set_command(self, v: float, w: float) -> None:
+        msg = Twist()
+        msg.linear.x, msg.angular.z = float(v), float(w)
+        self._pub.publish(msg)
+
+
+class RosNavigation:
+    """The map from /map (latched, republished when doors change) and plans on it."""
+
+    def __init__(self, node: Node) -> None:
+        self.grid: Grid | None = None
+        node.create_subscription(OccupancyGrid, n.MAP, self._on_map, LATCHED_QOS)
+
+    def _on_map(self, msg: OccupancyGrid) -> None:
+        data = np.array(msg.data, dtype=np.int8).reshape(msg.info.height, msg.info.width)
+        self.grid = Grid(data, (msg.info.origin.position.x, msg.info.origin.position.y), msg.info.resolution)
+
+    def map(self) -> Grid:
+        return self.grid
+
+    def plan(self, start: tuple[float, float], goal: tuple[float, float]) -> PlannedPath:
+        return plan_path(self.grid, start, goal)
+
+
+def layout_from_ground_truth(client: RavhClient) -> Layout:
+    """Room floors and ceiling lights from the sim's ground-truth queries."""
+    rooms = {}
+    for summary in client.query("rooms"):
+        room = client.query("room", id=summary["id"])
+        rooms[room["id"]] = (tuple(tuple(p) for p in room["floor"]),)
+    lights = tuple((o["room"], tuple(o["position"][:2])) for o in client.query("objects_with_tag", tag="Light"))
+    return Layout(rooms, lights)
+
+
+class BehaviourNode(Node):
+    """Hosts one behaviour: ``make_behaviour(follower, layout, grid, start_xy)`` builds it once the sim is up."""
+
+    def __init__(self, name: str, make_behaviour: Callable[[PathFollower, Layout, Grid, tuple], Any],
+                 agent: str = FIRST_AGENT, profile: str = "giraff", log_path: Path | None = None) -> None:
+        super().__init__(name, parameter_overrides=[Parameter("use_sim_time", value=True)])
+        first = agent == FIRST_AGENT
+        self.robot = RosRobot(self, agent, first)
+        self.navigation = RosNavigation(self)
+        self.client = RavhClient(self)
+        self.capture_client = self.create_client(Trigger, n.agent_name(n.CAPTURE_SERVICE, agent, first))
+        self.captures: list[dict[str, Any]] = []
+        self.finished = Future()                 # done when the behaviour ends (run_node returns then)
+        self._pending: set[Future] = set()
+        self._log_file = open(log_path, "a") if log_path else None
+        self._wait_for_sim()
+        layout = layout_from_ground_truth(self.client)
+        follower = PathFollower(self.robot, self.navigation, load_profile(profile))
+        self.behaviour = make_behaviour(follower, layout, self.navigation.grid, self.robot.pose[:2])
+        self._last_t: float | None = None
+        self._rooms_seen: set[str] = set()
+        self.timer = self.create_timer(1.0 / CONTROL_HZ, self._tick)
+        self.get_logger().info(f"{name}: started at {tuple(round(v, 2) for v in self.robot.pose)}")
+
+    def _wait_for_sim(self) -> None:
+        import rclpy
+        end = time.monotonic() + STARTUP_TIMEOUT_S
+        while time.monotonic() < end:
+            if self.robot.pose_msg and self.navigation.grid is not None and \
+                    self.client.wait_for_services(0.1) and self.capture_client.service_is_ready():
+                return
+            rclpy.spin_once(self, timeout_sec=0.1)
+        raise UserError(f"no sim node answered within {STARTUP_TIMEOUT_S:.0f} s "
+                        f"(is `ravh sim` running on ROS_DOMAIN_ID {os.environ.get('ROS_DOMAIN_ID', '0')}?)")
+
+    def _tick(self) -> None:
+        now = self.get_clock().now().nanoseconds * 1e-9
+        dt = 1.0 / CONTROL_HZ if self._last_t is None else now - self._last_t
+        self._last_t = now
+        if dt <= 0:
+            return
+        for reason in self.behaviour.update(dt):
+            future = self.capture_client.call_async(Trigger.Request())
+            self._pending.add(future)
+            future.add_done_callback(lambda f, r=reason: self._on_capture(f, r))
+        if self.behaviour.done:
+            self.timer.cancel()
+            self.robot.set_command(0.0, 0.0)
+            self._finish_when_answered()
+
+    def _finish_when_answered(self) -> None:
+        """End once the behaviour is done and every capture it asked for has been answered."""
+        if self.behaviour.done and not self._pending and not self.finished.done():
+            self.get_logger().info(f"done: {len(self.captures)} captures, rooms {sorted(self._rooms_seen)}")
+            self.finished.set_result(True)
+
+    def _on_capture(self, future, reason: str) -> None:
+        self._pending.discard(future)
+        self._record(future.result(), reason)
+        self._finish_when_answered()
+
+    def _record(self, result: Trigger.Response | None, reason: str) -> None:
+        if result is None or not result.success:
+            self.get_logger().warning(f"capture failed: {getattr(result, 'message', 'no reply')}")
+            return
+        event = json.loads(result.message)
+        event["reason"] = reason
+        self.captures.append(event)
+        if event.get("room"):
+            self._rooms_seen.add(event["room"])
+        x, y, yaw = event["pose"]
+        self.get_logger().info(f"capture {len(self.captures)} t={event['stamp']:.2f} pose=({x:.2f}, {y:.2f}, "
+                               f"{math.degrees(yaw):.0f} deg) room={event['room']} [{reason}]")
+        if self._log_file:
+            self._log_file.write(json.dumps(event) + "\n")
+            self._log_file.flush()
+
+    def close(self) -> None:
+        if self.context.ok():                    # after SIGINT the context is already shut down
+            self.robot.set_command(0.0, 0.0)
+        if self._log_file:
+            self._log_file.close()
+
+
+def common_args(prog: str, description: str) -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog=prog, description=description)
+    p.add_argument("--agent", default=FIRST_AGENT,
+                   help=f"agent to drive (default {FIRST_AGENT}, whose topics have no prefix)")
+    p.add_argument("--profile", default="giraff", help="robot profile of that agent")
+    p.add_argument("--log", type=Path, help="append every capture (pose, room) to this JSON-lines file")
+    return p
