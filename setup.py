@@ -30,7 +30,7 @@ setup(
         *tree("houses"),
         *tree("config"),
     ],
-    install_requires=["numpy", "pybullet", "opencv-python-headless", "pyyaml", "trimesh"],
+    install_requires=["numpy", "pybullet", "opencv-python-headless", "pyyaml", "trimesh", "rosbags"],
     zip_safe=True,
     maintainer="ravh_sim developers",
     description="Robot@VirtualHome for ROS 2: realistic virtual houses in pybullet",

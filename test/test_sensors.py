@@ -78,7 +78,8 @@ def _box_house():
                    {"id": "Light_1", "kind": "ceiling", "room": "B", "position": [7.6, 2.0, 2.65],
                     "intensity": 1.0, "range": 10.0, "color": [1.0, 0.8, 0.45]}],
         "objects": [_object("Door_0", "Door", "A", (6.1, 1.5, 1.05), (0.2, 1.0, 2.1)),
-                    _object("Wall_0", "Wall", "A", (-0.05, 2.0, 1.5), (1.2, 0.17, 1.0), -math.pi / 2, "Window"),
+                    _object("Wall_0", "Wall", "A", (-0.05, 2.0, 1.5), (1.2, 0.17, 1.0), -math.pi / 2,
+                            "Window"),
                     _object("Light_0", "Light", "A", (3.0, 2.0, 2.75), (0.36, 0.36, 0.08)),
                     _object("Light_1", "Light", "B", (7.6, 2.0, 2.75), (0.36, 0.36, 0.08)),
                     _object("Closet_0", "Closet", "B", (8.6, 3.0, 1.0), (0.6, 1.2, 2.0)),
@@ -118,14 +119,16 @@ def camera(world):
 
 
 def _ids(world, kind=None, name=None):
-    return {i.id for i in world.instances if (kind is None or i.kind == kind) and (name is None or i.name == name)}
+    return {i.id for i in world.instances
+            if (kind is None or i.kind == kind) and (name is None or i.name == name)}
 
 
 # ----------------------------------------------------------------------------- camera geometry
 
 def test_K_follows_the_paper_formula(camera):
     spec = PROFILE.camera
-    fx, fy = spec.focal_length * spec.width / spec.sensor_width, spec.focal_length * spec.height_px / spec.sensor_height
+    fx = spec.focal_length * spec.width / spec.sensor_width
+    fy = spec.focal_length * spec.height_px / spec.sensor_height
     assert camera.K == pytest.approx(np.array([[fx, 0, 320.0], [0, fy, 240.0], [0, 0, 1]]))
     assert fx == pytest.approx(548.571, abs=1e-3) and fy == pytest.approx(568.421, abs=1e-3)
     info = camera.camera_info
@@ -169,8 +172,7 @@ def _plane_depth(camera, x, y, yaw, row, plane_x=6.0):
     """Expected z-depth along image ``row`` of the vertical plane x = plane_x."""
     position, rotation = camera.optical_pose(x, y, yaw)
     us = np.arange(camera.width)
-    rays = np.stack([(us - camera.K[0, 2]) / camera.K[0, 0], np.full(len(us), (row - camera.K[1, 2]) / camera.K[1, 1]),
-                     np.ones(len(us))])
+    rays = np.linalg.inv(camera.K) @ np.stack([us, np.full(len(us), row), np.ones(len(us))])
     return (plane_x - position[0]) / (rotation @ rays)[0]
 
 
@@ -193,7 +195,8 @@ def test_depth_of_a_wall_is_z_depth_within_a_centimetre(camera, world):
 
 def test_nothing_hit_is_nan_and_instance_zero(camera):
     cap = camera.capture(3.0, 2.0, math.pi)
-    up = SmartCamera(camera.world, replace(PROFILE.camera, pitch_deg=-80.0)).capture(3.0, 2.0, 0.0, floor_z=10.0)
+    looking_up = SmartCamera(camera.world, replace(PROFILE.camera, pitch_deg=-80.0))
+    up = looking_up.capture(3.0, 2.0, 0.0, floor_z=10.0)
     assert np.isfinite(cap.depth).all() and (cap.instance > 0).all()
     assert np.isnan(up.depth).mean() > 0.9 and (up.instance[np.isnan(up.depth)] == 0).all()
 
@@ -434,7 +437,9 @@ def test_distortion_moves_pixels_as_cv2_projects_them(world, camera):
     position, rotation = bent.optical_pose(x, y, yaw)
     point = np.array([6.0, 3.3, 0.0])                 # floor meets the east wall
     cam_point = (point - position) @ rotation
-    (u, v), = cv2.projectPoints(cam_point[None], np.zeros(3), np.zeros(3), bent.K, np.array(coefficients))[0][:, 0]
+    zero = np.zeros(3)
+    projected, _ = cv2.projectPoints(cam_point[None], zero, zero, bent.K, np.array(coefficients))
+    u, v = projected[0, 0]
     col = cap.instance[:, int(round(u))]
     walls, floors = world.instance("A/walls").id, world.instance("A/floor").id
     boundary = np.flatnonzero((col[:-1] == walls) & (col[1:] == floors))
@@ -473,7 +478,7 @@ def test_render_command_writes_images_and_info(tmp_path, capsys):
     mask = cv2.imread(str(out / "mask.png"))
     info = json.loads((out / "info.json").read_text())
     assert info["K"][0][0] == pytest.approx(548.571, abs=1e-3) and info["sun_angle"] == 200.0
-    assert sum(i["pixels"] for i in info["instances"]) == 640 * 480
+    assert sum(i["pixels"] for i in info["instances"]) + info["pixels_without_instance"] == 640 * 480
     top = info["instances"][0]
     assert (mask[:, :, ::-1].reshape(-1, 3) == top["mask_color"]).all(axis=1).sum() == top["pixels"]
     assert main(["render", "15", "--pose", "0", "0", "0", "--sun", "noon", "-o", str(out)]) == 2

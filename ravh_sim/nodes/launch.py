@@ -6,9 +6,11 @@ import sys
 
 NODES = {
     "sim": "ravh_sim.nodes.sim_node",
+    "recorder": "ravh_sim.nodes.recorder_node",
     "wanderer": "ravh_sim.nodes.wanderer_node",
     "grid": "ravh_sim.nodes.grid_node",
     "teleop": "ravh_sim.nodes.teleop_node",
+    "probe": "ravh_sim.nodes.probe_node",
 }
 
 

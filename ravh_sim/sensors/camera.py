@@ -33,6 +33,9 @@ from ravh_sim.world.scene import World
 
 DISTORTION_MODEL = "plumb_bob"
 NOISE_STREAM = 1            # noise generator stream of cameras (lasers use another)
+# Where each renderer samples a pixel (see projection_from_K), measured against K: OpenGL samples
+# pixel centres; TinyRenderer samples pixel corners, and its flipped rows are one pixel off.
+SAMPLE_OFFSET = {"egl": (0.5, 0.5), "tiny": (0.0, 1.0)}
 # Optical frame -> OpenGL eye frame (x right, y up, z backwards).
 OPTICAL_TO_GL = np.diag([1.0, -1.0, -1.0])
 
@@ -94,7 +97,8 @@ class SmartCamera:
         self.options = options or CameraOptions()
         self.width, self.height = spec.width, spec.height_px
         self.K = np.array([[spec.fx, 0.0, spec.cx], [0.0, spec.fy, spec.cy], [0.0, 0.0, 1.0]])
-        self.projection = projection_from_K(self.K, self.width, self.height, spec.near, spec.far)
+        self.projection = projection_from_K(self.K, self.width, self.height, spec.near, spec.far,
+                                            SAMPLE_OFFSET[world.renderer])
         self.camera_info = self._camera_info()
         self._gl_projection = self.projection.T.ravel().tolist()      # column-major for pybullet
         self._lens = (imaging.LensDistortion(self.K, self.options.distortion, self.width, self.height)
@@ -182,9 +186,6 @@ class SmartCamera:
         """(H, W, 3) uint8 image of the instance ids in their footprint mask colours (black = nothing)."""
         return self._instance_rgb[capture.instance]
 
-    def encode_jpeg(self, rgb: np.ndarray) -> bytes:
-        return imaging.encode_jpeg(rgb, self.options.jpeg_quality)
-
     def _render(self, position: np.ndarray, rotation: np.ndarray, light_direction
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """One pybullet render: (rgb uint8, z-depth float32, instance uint16, background mask)."""
@@ -219,16 +220,20 @@ class SmartCamera:
                           tuple(float(v) for v in np.eye(3).ravel()), tuple(float(v) for v in p.ravel()))
 
 
-def projection_from_K(K: np.ndarray, width: int, height: int, near: float, far: float) -> np.ndarray:
+def projection_from_K(K: np.ndarray, width: int, height: int, near: float, far: float,
+                      sample_offset: tuple[float, float] = (0.5, 0.5)) -> np.ndarray:
     """OpenGL projection (row-major 4x4) whose pixels match the pinhole model K exactly.
 
-    Pixel u (OpenCV: centre at integer u) is window x = u + 0.5; pybullet flips rows, so image row v
-    is window y = height - v - 0.5. Solving NDC = f(K) for both gives the principal-point terms.
+    OpenCV's pixel (u, v) has its centre at (u, v). A renderer colours it with what it finds at
+    window x = u + ox and, rows being flipped, y = height - v - oy, with (ox, oy) = ``sample_offset``:
+    (0.5, 0.5) for OpenGL, which samples pixel centres. Solving NDC = f(K) for both axes gives the
+    principal-point terms.
     """
     fx, fy, cx, cy = K[0, 0], K[1, 1], K[0, 2], K[1, 2]
+    ox, oy = sample_offset
     return np.array([
-        [2 * fx / width, 0.0, 1 - (2 * cx + 1) / width, 0.0],
-        [0.0, 2 * fy / height, (2 * cy + 1) / height - 1, 0.0],
+        [2 * fx / width, 0.0, 1 - 2 * (cx + ox) / width, 0.0],
+        [0.0, 2 * fy / height, 2 * (cy + oy) / height - 1, 0.0],
         [0.0, 0.0, -(far + near) / (far - near), -2 * far * near / (far - near)],
         [0.0, 0.0, -1.0, 0.0]])
 
@@ -263,6 +268,6 @@ def write_capture(camera: SmartCamera, capture: Capture, directory: Path) -> lis
             "camera_info": asdict(capture.camera_info), "sun_angle": camera.world.settings.sun_angle,
             "lights_on": sorted(k for k, on in camera.world.settings.lights.items() if on),
             "depth_png": "uint16 millimetres along the optical axis, 0 = no depth",
-            "instances": visible}
+            "pixels_without_instance": int(counts[0]), "instances": visible}
     paths[3].write_text(json.dumps(info, indent=1) + "\n")
     return paths

@@ -5,9 +5,9 @@ Rays go out from the laser height in a few ``rayTestBatch`` calls of growing len
 where the hit is closer than ``range_min``. The robot's own body must not shadow the scan, but a
 batch cannot skip bodies: rays whose first hit is an ignored body are cast again from where they
 leave that body's bounding box. (Rays that start inside a convex body never hit it, so a body
-around the laser needs no ignoring; a bumper or mast in front of it does.) Open doors are moved out of the house by the
-World, so the laser sees through open doorways; closed doors, walls and furniture stop it. Noise is
-Gaussian, seeded from the world seed and a scan counter.
+around the laser needs no ignoring; a bumper or mast in front of it does.) Open doors are moved out
+of the house by the World, so the laser sees through open doorways; closed doors, walls and
+furniture stop it. Noise is Gaussian, seeded from the world seed and a scan counter.
 """
 from __future__ import annotations
 
@@ -98,25 +98,25 @@ class Laser:
         todo = np.arange(n)
         ends = [e for e in STAGES if e < self.spec.range_max] + [self.spec.range_max]
         for end in ends:
+            go = todo
             for _ in range(MAX_RECASTS):
-                go = todo[start[todo] < end]
+                go = go[start[go] < end]
                 if not go.size:
                     break
-                hits = pb.rayTestBatch(origin + directions[go] * start[go, None], origin + directions[go] * end,
-                                       physicsClientId=self.world.client)
+                hits = pb.rayTestBatch(origin + directions[go] * start[go, None],
+                                       origin + directions[go] * end, physicsClientId=self.world.client)
                 body = np.fromiter((h[0] for h in hits), np.int64, len(hits))
                 point = np.array([h[3] for h in hits])
                 skip = np.isin(body, list(ignore)) if ignore else np.zeros(len(go), bool)
                 found = (body >= 0) & ~skip
                 bodies[go[found]] = body[found]
                 distances[go[found]] = np.einsum("ij,ij->i", point[found] - origin, directions[go[found]])
-                start[go[body < 0]] = end - STAGE_OVERLAP
+                start[go[body < 0]] = end - STAGE_OVERLAP          # goes on in the next stage
                 for i in np.flatnonzero(skip):
                     aabb = pb.getAABB(int(body[i]), physicsClientId=self.world.client)
                     start[go[i]] = _box_exit(origin, directions[go[i]], aabb) + RECAST_GAP
                 todo = todo[~np.isin(todo, go[found])]
-                if not skip.any():
-                    break
+                go = go[skip]                                     # again, past the ignored body
         return bodies, distances
 
 

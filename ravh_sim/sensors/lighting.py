@@ -35,6 +35,7 @@ EMISSIVE = 1.6             # gain of a switched-on light's own fixture (lamp sha
 NORMAL_BASELINE = 2        # light-map samples spanned by a surface tangent
 NORMAL_BLUR = 5            # box filter (light-map samples) over normals
 FAR_FILL = 1e3             # m: stands in for "no depth" so no NaN reaches the light sums
+CREASE_COS = 0.7           # filtered normal over ~45 degrees off the raw one: keep the raw one
 SILHOUETTE_JUMP = 0.1      # a tangent whose depth step exceeds 0.1 * z per sample bridges two surfaces
 GLASS_MARGIN = 0.03        # m beyond a window's half thickness where the wall face still counts as pane
 STEP = 2                   # light map: one sample per STEP x STEP pixels
@@ -44,7 +45,6 @@ class Lighting:
     """Per-camera lighting pass over one World; reusable for every frame."""
 
     def __init__(self, world: World, K: np.ndarray, width: int, height: int, step: int = STEP) -> None:
-        self.world = world
         self.width, self.height, self.step = width, height, step
         self.fx, self.fy, self.cx, self.cy = float(K[0, 0]), float(K[1, 1]), float(K[0, 2]), float(K[1, 2])
         self._rx = ((np.arange(width) - self.cx) / self.fx).astype(np.float32)
@@ -214,25 +214,33 @@ def _normals(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, n
     The depth buffer is 16-bit, so neighbouring points are a few millimetres off their surface:
     tangents span NORMAL_BASELINE samples, tangents that bridge a depth jump (silhouettes) are
     dropped, and the normals are box-filtered, which also fills the dropped ones from their
-    neighbours. Rows run down and columns right, so (down x right) faces the camera.
+    neighbours. Where the filtered normal turns away from the raw one, a crease (two faces of one
+    object) is near and the raw normal is kept, so edges do not glow. Rows run down and columns
+    right, so (down x right) faces the camera.
     """
     k = NORMAL_BASELINE
     ux, uy, uz = (a[:-k, k:] - a[:-k, :-k] for a in (x, y, z))
     vx, vy, vz = (a[k:, :-k] - a[:-k, :-k] for a in (x, y, z))
-    n = [vy * uz - vz * uy, vz * ux - vx * uz, vx * uy - vy * ux]
+    n = (vy * uz - vz * uy, vz * ux - vx * uz, vx * uy - vy * ux)
     limit = SILHOUETTE_JUMP * k * z[:-k, :-k]
     with np.errstate(invalid="ignore"):
         keep = (np.abs(uz) < limit) & (np.abs(vz) < limit)            # also drops NaN (no depth)
-    inverse = np.where(keep, 1.0 / np.maximum(np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), 1e-12), 0.0)
-    merged = cv2.merge([np.nan_to_num(c * inverse).astype(np.float32) for c in n])
-    merged = cv2.copyMakeBorder(merged, 0, k, 0, k, cv2.BORDER_REPLICATE)
-    nx, ny, nz = np.ascontiguousarray(cv2.blur(merged, (NORMAL_BLUR, NORMAL_BLUR)).transpose(2, 0, 1))
-    inverse = 1.0 / np.maximum(np.sqrt(nx * nx + ny * ny + nz * nz), 1e-6)
-    return nx * inverse, ny * inverse, nz * inverse
+        inverse = np.where(keep, 1.0 / np.sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), 0.0)
+    border = (k // 2, k - k // 2, k // 2, k - k // 2)                   # centre each normal on its span
+    raw = [cv2.copyMakeBorder(np.nan_to_num(c * inverse), *border, cv2.BORDER_REPLICATE) for c in n]
+    smooth = [cv2.blur(c, (NORMAL_BLUR, NORMAL_BLUR)) for c in raw]
+    length = np.sqrt(smooth[0] * smooth[0] + smooth[1] * smooth[1] + smooth[2] * smooth[2])
+    inverse = 1.0 / np.maximum(length, 1e-6)
+    smooth = [c * inverse for c in smooth]
+    edge = (smooth[0] * raw[0] + smooth[1] * raw[1] + smooth[2] * raw[2]) < CREASE_COS
+    edge &= cv2.copyMakeBorder(keep.view(np.uint8), *border, cv2.BORDER_REPLICATE).view(bool)
+    nx, ny, nz = (np.where(edge, r, c) for r, c in zip(raw, smooth))
+    return nx, ny, nz
 
 
 def _scale(rgb: np.ndarray, gain: np.ndarray) -> np.ndarray:
     """Multiply each channel by a constant through a lookup table (the cheap no-lamp path), rounding
     as cv2.multiply does on the lamp path so both paths agree on unlit pixels."""
-    table = np.clip(np.rint(np.arange(256, dtype=np.float32)[:, None] * gain[None, :]), 0, 255).astype(np.uint8)
+    table = np.rint(np.arange(256, dtype=np.float32)[:, None] * gain[None, :])
+    table = np.clip(table, 0, 255).astype(np.uint8)
     return cv2.LUT(rgb, table.reshape(1, 256, 3))

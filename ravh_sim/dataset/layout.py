@@ -1,0 +1,96 @@
+"""The on-disk dataset format in one place: file names, pixel encodings and the atomic write.
+
+The writer and the reader both import these, so the format (documented in README.md beside this
+file) cannot drift between them. Every file is written under a temporary name in its own directory
+and renamed into place, so a reader (or a recorder killed at any instant) never sees half a file.
+"""
+from __future__ import annotations
+
+import io
+import os
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+FORMAT = "ravh_sim/dataset@1"
+
+DATASET_JSON = "dataset.json"          # format, house, agents, created, raid metadata
+FOOTPRINT_JSON = "footprint.json"      # the footprint of the run (ravh_sim/footprint@1)
+SETTINGS_JSON = "settings.json"        # the footprint's resolved settings, on their own
+CAMERA_JSON = "camera.json"            # agent -> camera intrinsics
+CAPTURES_JSONL = "captures.jsonl"      # one line per complete capture
+MAP_DIR = "map"                        # map.pgm + map.yaml (map_server format)
+MAP_NAME = "map"
+BAG_DIR = "bag"                        # rosbag2, MCAP storage
+TMP_PREFIX = "."                       # temporary files are hidden: ".<name>.<pid>.tmp"
+
+#: Per-capture files: kind -> (folder, extension).
+CAPTURE_FILES: dict[str, tuple[str, str]] = {
+    "rgb": ("rgb", ".png"),            # 8-bit RGB
+    "depth": ("depth", ".png"),        # 16-bit millimetres, 0 = no depth
+    "mask": ("mask", ".png"),          # 16-bit instance ids, 0 = nothing
+    "scan": ("scan", ".npy"),          # float32 (N, 2): angle (rad), range (m; inf/nan as published)
+}
+DEPTH_SCALE = 1000.0                   # depth PNG units per metre
+DEPTH_MAX_M = 65.535                   # deepest representable depth; farther is stored as 0
+
+
+def capture_files(index: int) -> dict[str, str]:
+    """Relative paths of capture ``index``'s files, by kind."""
+    return {kind: f"{folder}/{index:06d}{ext}" for kind, (folder, ext) in CAPTURE_FILES.items()}
+
+
+def atomic_write(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` all at once: temp file in the same folder, fsync, rename.
+
+    The fsync before the rename keeps the name from ever pointing at unwritten blocks after a
+    power loss; os.replace is atomic on POSIX, so readers see the old file or the new one.
+    """
+    tmp = path.with_name(f"{TMP_PREFIX}{path.name}.{os.getpid()}.tmp")
+    with open(tmp, "wb") as f:
+        f.write(data)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def encode_png(image: np.ndarray) -> bytes:
+    """PNG bytes of an 8-bit RGB (H, W, 3) or a 16-bit (H, W) image."""
+    if image.ndim == 3:
+        image = cv2.cvtColor(image, cv2.COLOR_RGB2BGR)
+    ok, buf = cv2.imencode(".png", image, [cv2.IMWRITE_PNG_COMPRESSION, 1])
+    if not ok:
+        raise ValueError(f"cannot encode a {image.dtype} {image.shape} image as PNG")
+    return buf.tobytes()
+
+
+def read_png(path: Path) -> np.ndarray:
+    """The pixels of a PNG as written by :func:`encode_png` (RGB order for colour images)."""
+    image = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    if image is None:
+        raise OSError(f"{path}: cannot read the PNG")
+    return cv2.cvtColor(image, cv2.COLOR_BGR2RGB) if image.ndim == 3 else image
+
+
+def depth_to_png(metres: np.ndarray) -> np.ndarray:
+    """Float metres (NaN/inf/<=0 invalid) -> uint16 millimetres, 0 = invalid (±0.5 mm rounding)."""
+    mm = np.round(np.asarray(metres, np.float64) * DEPTH_SCALE)
+    valid = np.isfinite(mm) & (mm > 0) & (mm <= DEPTH_MAX_M * DEPTH_SCALE)
+    return np.where(valid, mm, 0).astype(np.uint16)
+
+
+def depth_from_png(mm: np.ndarray) -> np.ndarray:
+    """uint16 millimetres -> float32 metres, NaN where 0 (the REP 118 convention of the topic)."""
+    metres = mm.astype(np.float32) / np.float32(DEPTH_SCALE)
+    metres[mm == 0] = np.nan
+    return metres
+
+
+def encode_scan(ranges: np.ndarray, angle_min: float, angle_increment: float) -> bytes:
+    """.npy bytes of the (N, 2) float32 [angle, range] array stored per capture."""
+    ranges = np.asarray(ranges, np.float32).reshape(-1)
+    angles = angle_min + angle_increment * np.arange(len(ranges), dtype=np.float64)
+    buf = io.BytesIO()
+    np.save(buf, np.column_stack((angles.astype(np.float32), ranges)), allow_pickle=False)
+    return buf.getvalue()

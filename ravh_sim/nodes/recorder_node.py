@@ -1,0 +1,345 @@
+"""The recorder node: requested captures into a dataset folder, and the raid into a rosbag2 (MCAP).
+
+``ros2 run ravh_sim recorder --out DIR [--no-bag] [--agent NAME] [--raid JSON]`` (or ``ravh recorder
+...``). Every topic is subscribed raw (serialized CDR): the bag stores the bytes exactly as received,
+and only the messages that end up in the dataset are deserialized, in a worker thread that encodes
+and writes the files while the executor keeps receiving.
+
+A capture is the set of messages that share the stamp of a ``ravh/capture`` event: RGB, depth,
+instances, camera_infos and the scan. Events and images arrive on different topics in any order, so
+parts wait by stamp in :class:`StampMatcher` until the set is complete; periodic camera frames never
+get an event and are dropped unrecorded. The bag keeps the continuous streams (scan, odom,
+ground-truth pose, capture events) whole, the latched ones (/map, /ravh/ground_truth, instance
+labels) with transient-local QoS so ``ros2 bag play`` re-latches them, and of the camera only the
+captures (JPEG colour, depth, instances, camera_infos), so bag and dataset describe the same frames.
+Bag times are sim receive times (``use_sim_time``); messages that arrive before the first /clock are
+written at the first clock time. SIGINT closes the bag (metadata.yaml written); a SIGKILLed recorder
+leaves a dataset that reads back complete up to its last capture, and an MCAP without its summary
+(``mcap recover`` rebuilds it).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import struct
+import time
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+from geometry_msgs.msg import PoseStamped
+from nav_msgs.msg import OccupancyGrid, Odometry
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile
+from rclpy.serialization import deserialize_message
+from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
+from rosbags.rosbag2 import StoragePlugin, Writer
+from rosbags.typesys import Stores, get_typestore
+from sensor_msgs.msg import CameraInfo, CompressedImage, Image, LaserScan
+from std_msgs.msg import String
+
+from ravh_msgs_py import names as n
+from ravh_sim.dataset import layout
+from ravh_sim.dataset.writer import DatasetWriter
+from ravh_sim.errors import UserError
+from ravh_sim.nav.grid import Grid
+from ravh_sim.nodes import convert
+from ravh_sim.nodes.common import LATCHED_QOS, SENSOR_QOS, STATE_QOS, run_node
+
+NS = 1_000_000_000
+PENDING_TIMEOUT_S = 10.0      # wall seconds a stamp's parts wait for the rest of their capture
+MAX_PENDING = 32              # stamps buffered at most (periodic frames without an event go first)
+
+# Per-agent topics: part -> (base name, message type, QoS, in the dataset, in the bag, per capture).
+# Parts "per capture" are buffered by stamp and bagged only for captures; the others stream through.
+PARTS: dict[str, tuple[str, type, QoSProfile, bool, bool, bool]] = {
+    "rgb": (n.COLOR_IMAGE, Image, SENSOR_QOS, True, False, True),
+    "jpeg": (n.COLOR_COMPRESSED, CompressedImage, SENSOR_QOS, False, True, True),
+    "depth": (n.DEPTH_IMAGE, Image, SENSOR_QOS, True, True, True),
+    "instance": (n.INSTANCE_IMAGE, Image, SENSOR_QOS, True, True, True),
+    "rgb_info": (n.COLOR_INFO, CameraInfo, SENSOR_QOS, True, True, True),
+    "depth_info": (n.DEPTH_INFO, CameraInfo, SENSOR_QOS, False, True, True),
+    "scan": (n.SCAN, LaserScan, SENSOR_QOS, True, True, False),
+    "odom": (n.ODOM, Odometry, STATE_QOS, False, True, False),
+    "gt_pose": (n.GROUND_TRUTH_POSE, PoseStamped, STATE_QOS, False, True, False),
+    "event": (n.CAPTURE_EVENT, String, STATE_QOS, True, True, False),
+}
+# Latched, not per agent: name -> (message type, in the dataset).
+LATCHED: dict[str, tuple[type, bool]] = {
+    n.GROUND_TRUTH: (String, True),
+    n.MAP: (OccupancyGrid, True),
+    n.INSTANCE_LABELS: (String, False),
+}
+
+
+def type_name(msg_type: type) -> str:
+    """'sensor_msgs/msg/Image' for sensor_msgs.msg.Image."""
+    return f"{msg_type.__module__.split('.')[0]}/msg/{msg_type.__name__}"
+
+
+def header_stamp_ns(cdr: bytes) -> int:
+    """The header stamp of a serialized stamped message, read without deserializing it.
+
+    CDR: 4 bytes of encapsulation (byte 1: 0 big-, 1 little-endian), then the first field, the
+    std_msgs/Header, whose stamp is int32 sec, uint32 nanosec.
+    """
+    sec, nanosec = struct.unpack_from("<iI" if cdr[1] & 1 else ">iI", cdr, 4)
+    return sec * NS + nanosec
+
+
+def event_stamp_ns(seconds: float) -> int:
+    """The header stamp the sim gave the messages of a capture whose event says ``seconds``."""
+    t = convert.stamp(seconds)
+    return t.sec * NS + t.nanosec
+
+
+# ---------------------------------------------------------------------------- matching
+
+@dataclass
+class _Pending:
+    created: float                                    # wall time of the first part
+    parts: dict[str, Any] = field(default_factory=dict)
+
+
+class StampMatcher:
+    """Gathers a capture's parts by stamp; hands the set over once every required part is in."""
+
+    def __init__(self, required: set[str], max_pending: int = MAX_PENDING,
+                 timeout_s: float = PENDING_TIMEOUT_S) -> None:
+        self.required = frozenset(required)
+        self.max_pending, self.timeout_s = max_pending, timeout_s
+        self.pending: dict[int, _Pending] = {}
+        self.lost: list[int] = []                     # stamps of captures (with an event) given up on
+
+    def add(self, stamp_ns: int, part: str, value: Any, now: float) -> dict[str, Any] | None:
+        """Add one part (the first of a stamp wins); returns the complete set, else None."""
+        entry = self.pending.setdefault(stamp_ns, _Pending(now))
+        entry.parts.setdefault(part, value)
+        if self.required <= entry.parts.keys():
+            del self.pending[stamp_ns]
+            return entry.parts
+        self._prune(now)
+        return None
+
+    def _prune(self, now: float) -> None:
+        for stamp, entry in list(self.pending.items()):
+            if now - entry.created > self.timeout_s:
+                self._drop(stamp)
+        idle = sorted(s for s, e in self.pending.items() if "event" not in e.parts)
+        for stamp in idle[:max(0, len(self.pending) - self.max_pending)]:
+            self._drop(stamp)
+
+    def _drop(self, stamp: int) -> None:
+        if "event" in self.pending.pop(stamp).parts:
+            self.lost.append(stamp)
+
+
+# ---------------------------------------------------------------------------- the bag
+
+class BagWriter:
+    """A rosbag2 folder with MCAP storage, written from serialized messages with ``rosbags``."""
+
+    def __init__(self, path: Path) -> None:
+        self._typestore = get_typestore(Stores.ROS2_JAZZY)
+        self._writer = Writer(path, version=9, storage_plugin=StoragePlugin.MCAP)
+        self._writer.open()
+        self._connections: dict[str, Any] = {}
+        self._early: list[tuple[str, bytes]] = []     # before the first /clock
+
+    def add_topic(self, topic: str, msg_type: type, latched: bool) -> None:
+        zero = QosTime(0, 0)
+        qos = Qos(QosHistory.KEEP_LAST, 1 if latched else 10, QosReliability.RELIABLE,
+                  QosDurability.TRANSIENT_LOCAL if latched else QosDurability.VOLATILE, zero, zero,
+                  QosLiveliness.AUTOMATIC, zero, False)
+        self._connections[topic] = self._writer.add_connection(
+            topic, type_name(msg_type), typestore=self._typestore, offered_qos_profiles=[qos])
+
+    def write(self, topic: str, t_ns: int, data: bytes) -> None:
+        if t_ns <= 0:
+            self._early.append((topic, data))
+            return
+        self._flush_early(t_ns)
+        self._writer.write(self._connections[topic], t_ns, data)
+
+    def close(self) -> None:
+        self._flush_early(1)                          # never saw a clock: keep them anyway
+        self._writer.close()
+
+    def _flush_early(self, t_ns: int) -> None:
+        for topic, data in self._early:
+            self._writer.write(self._connections[topic], t_ns, data)
+        self._early.clear()
+
+
+# ---------------------------------------------------------------------------- decoding
+
+def image_array(msg: Image) -> np.ndarray:
+    """The pixels of an rgb8, 32FC1 or 16UC1 Image (row padding removed)."""
+    dtype, channels = {"rgb8": (np.uint8, 3), "32FC1": (np.float32, 1), "16UC1": (np.uint16, 1)}[msg.encoding]
+    row_bytes = msg.width * channels * np.dtype(dtype).itemsize
+    rows = np.frombuffer(msg.data, np.uint8).reshape(msg.height, msg.step)[:, :row_bytes]
+    a = np.ascontiguousarray(rows).view(dtype).reshape(msg.height, msg.width, channels)
+    return a[:, :, 0] if channels == 1 else a
+
+
+def camera_dict(info: CameraInfo) -> dict[str, Any]:
+    return {"width": info.width, "height": info.height, "K": [float(v) for v in info.k],
+            "D": [float(v) for v in info.d], "distortion_model": info.distortion_model,
+            "frame_id": info.header.frame_id}
+
+
+def grid_of(msg: OccupancyGrid) -> Grid:
+    data = np.array(msg.data, np.int8).reshape(msg.info.height, msg.info.width)
+    return Grid(data, (msg.info.origin.position.x, msg.info.origin.position.y), msg.info.resolution)
+
+
+# ---------------------------------------------------------------------------- the node
+
+class RecorderNode(Node):
+    def __init__(self, out: Path, bag: bool, agent: str | None, raid: dict[str, Any]) -> None:
+        super().__init__("ravh_recorder", parameter_overrides=[Parameter("use_sim_time", value=True)])
+        self.out, self.raid, self.wanted_agent = out, raid, agent
+        if bag and (out / layout.BAG_DIR).exists():
+            raise UserError(f"{out / layout.BAG_DIR} exists; record into a new folder")
+        self.writer = DatasetWriter(out)
+        self.bag = BagWriter(out / layout.BAG_DIR) if bag else None
+        self.worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="ravh_recorder_write")
+        self.parts = {k: v for k, v in PARTS.items() if v[3] or (bag and v[4])}
+        self.matcher = StampMatcher({k for k, v in self.parts.items() if v[5]} | {"event", "scan"})
+        self.agent: str | None = None
+        self.captures = 0
+        self.topics: dict[str, str] = {}              # part -> resolved topic name
+        for topic, (msg_type, in_dataset) in LATCHED.items():
+            if in_dataset or bag:
+                sub = self.create_subscription(msg_type, topic, lambda d, t=topic: self._on_latched(t, d),
+                                               LATCHED_QOS, raw=True)
+                if self.bag:
+                    self.bag.add_topic(sub.topic_name, msg_type, latched=True)
+                self.topics[topic] = sub.topic_name
+        self.get_logger().info(f"waiting for {n.GROUND_TRUTH} to learn the house and its agents")
+
+    # ------------------------------------------------------------------ set-up once the world is known
+    def _start(self, footprint: dict[str, Any]) -> None:
+        agents = [a["name"] for a in footprint["settings"].get("agents", [])]
+        if not agents:
+            raise UserError("the footprint names no agents; nothing to record")
+        agent = self.wanted_agent or agents[0]
+        if agent not in agents:
+            raise UserError(f"unknown agent {agent!r}; the sim has {', '.join(agents)}")
+        self.agent = agent
+        self._submit(self.writer.write_meta, footprint["house"], [agent], self.raid, self.bag is not None)
+        for part, (base, msg_type, qos, _, in_bag, _) in self.parts.items():
+            name = n.agent_name(base, agent, agent == agents[0])
+            sub = self.create_subscription(msg_type, name, lambda d, p=part: self._on_part(p, d), qos, raw=True)
+            self.topics[part] = sub.topic_name
+            if self.bag and in_bag:
+                self.bag.add_topic(sub.topic_name, msg_type, latched=False)
+        self.get_logger().info(f"recording agent {agent} of house {footprint['house']} into {self.out}"
+                               f" ({'with' if self.bag else 'no'} bag)")
+
+    # ------------------------------------------------------------------ callbacks
+    def _now_ns(self) -> int:
+        return self.get_clock().now().nanoseconds
+
+    def _on_latched(self, topic: str, data: bytes) -> None:
+        if self.bag:
+            self.bag.write(self.topics[topic], self._now_ns(), data)
+        if topic == n.GROUND_TRUTH:
+            footprint = json.loads(deserialize_message(data, String).data)
+            self._submit(self.writer.write_footprint, footprint)
+            if self.agent is None:
+                self._start(footprint)
+        elif topic == n.MAP:
+            self._submit(self.writer.write_map, grid_of(deserialize_message(data, OccupancyGrid)))
+
+    def _on_part(self, part: str, data: bytes) -> None:
+        now_ns = self._now_ns()
+        per_capture, in_bag = self.parts[part][5], self.parts[part][4]
+        if self.bag and in_bag and not per_capture:
+            self.bag.write(self.topics[part], now_ns, data)
+        if part == "event":
+            event = json.loads(deserialize_message(data, String).data)
+            if event.get("agent") != self.agent:
+                return
+            stamp, value = event_stamp_ns(float(event["stamp"])), event
+        elif part in self.matcher.required:
+            stamp, value = header_stamp_ns(data), (now_ns, data)
+        else:
+            return
+        parts = self.matcher.add(stamp, part, value, time.monotonic())
+        while self.matcher.lost:
+            self.get_logger().warning(f"capture at t={self.matcher.lost.pop(0) / NS:.3f} s incomplete: dropped")
+        if parts is not None:
+            self._complete(parts)
+
+    def _complete(self, parts: dict[str, Any]) -> None:
+        if self.bag:
+            for part, value in parts.items():
+                if self.parts[part][4] and self.parts[part][5]:
+                    self.bag.write(self.topics[part], *value)
+        self._submit(self._write_capture, parts)
+
+    def _write_capture(self, parts: dict[str, Any]) -> None:
+        """Worker thread: deserialize what the dataset keeps and write it."""
+        msgs = {p: deserialize_message(parts[p][1], self.parts[p][1]) for p in
+                ("rgb", "depth", "instance", "rgb_info", "scan")}
+        event, scan = parts["event"], msgs["scan"]
+        index = self.writer.write_capture(
+            event["stamp"], event["agent"], event["pose"], event["odom"], event["room"],
+            image_array(msgs["rgb"]), image_array(msgs["depth"]), image_array(msgs["instance"]),
+            np.asarray(scan.ranges, np.float32),
+            {"angle_min": scan.angle_min, "angle_increment": scan.angle_increment,
+             "range_min": scan.range_min, "range_max": scan.range_max},
+            camera_dict(msgs["rgb_info"]))
+        self.captures = index + 1
+        self.get_logger().info(f"capture {index} at t={event['stamp']:.2f} s in {event['room']}")
+
+    def _submit(self, fn: Callable[..., object], *args: Any) -> None:
+        self.worker.submit(fn, *args).add_done_callback(self._report)
+
+    def _report(self, future: Future) -> None:
+        if future.exception() is not None:
+            self.get_logger().error(f"dataset write failed: {future.exception()!r}")
+
+    def close(self) -> None:
+        """Finish queued writes, then close the dataset and the bag (SIGINT lands here)."""
+        waiting = sum("event" in e.parts for e in self.matcher.pending.values())
+        self.worker.shutdown(wait=True)
+        self.writer.close()
+        if self.bag:
+            self.bag.close()
+        self.get_logger().info(f"stopped: {self.captures} captures in {self.out}"
+                               + (f", {waiting} incomplete dropped" if waiting else ""))
+
+
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    p = argparse.ArgumentParser(prog="recorder", description="ravh_sim: record requested captures into a "
+                                "dataset folder (see ravh_sim/dataset/README.md) and a rosbag2")
+    p.add_argument("--out", type=Path, required=True, help="dataset folder (new, or empty)")
+    p.add_argument("--bag", action=argparse.BooleanOptionalAction, default=True,
+                   help="also record a rosbag2 (MCAP) in OUT/bag (default: yes)")
+    p.add_argument("--agent", default=None, help="agent to record (default: the first)")
+    p.add_argument("--raid", default="{}", help="JSON object stored as dataset.json's 'raid' (who, why, how)")
+    return p.parse_args(argv)
+
+
+def make_node(argv: list[str]) -> RecorderNode:
+    args = parse_args(argv)
+    try:
+        raid = json.loads(args.raid)
+    except ValueError as e:
+        raise UserError(f"--raid: not JSON: {e}") from None
+    if not isinstance(raid, dict):
+        raise UserError("--raid: expected a JSON object")
+    return RecorderNode(args.out, args.bag, args.agent, raid)
+
+
+def main(argv: list[str] | None = None) -> int:
+    return run_node(make_node, argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
