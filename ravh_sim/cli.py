@@ -173,6 +173,21 @@ def _sun_value(text: str) -> float | str:
         return text
 
 
+def cmd_raid(args: argparse.Namespace) -> int:
+    from ravh_sim.dataset.raid import run_raid
+    from ravh_sim.world.house import available_houses, load_house
+    houses = available_houses() if args.all else [args.house]
+    if not args.all:
+        load_house(args.house)                        # unknown house: the usual clear error
+    results = []
+    for house in houses:
+        out = args.out / f"house{house:02d}_raid{args.raid}" if args.all else args.out
+        results.append(run_raid(house, args.raid, out, fast=args.fast, seed=args.seed,
+                                max_captures=args.max_captures))
+    print(json.dumps(results if args.all else results[0], indent=1))
+    return 0 if all(r["status"] == "done" or r["status"].startswith("stopped") for r in results) else 1
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
     from ravh_sim import bench
     result = bench.run(args.what, houses=args.houses)
@@ -239,6 +254,17 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--profile", default="giraff", help="robot profile for the camera (default: giraff)")
     p.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     p.set_defaults(func=cmd_render)
+
+    p = sub.add_parser("raid", help="collect a dataset: sim + behaviour + recorder with a paper preset")
+    p.add_argument("--house", type=int, default=15, help="house number (default 15)")
+    p.add_argument("--raid", type=int, default=1, choices=range(5),
+                   help="0 grid/day, 1 wanderer/day, 2 random paint+models, 3 sunset, 4 night")
+    p.add_argument("--out", type=Path, required=True, help="dataset folder (with --all: parent folder)")
+    p.add_argument("--fast", action="store_true", help="run the sim faster than real time")
+    p.add_argument("--all", action="store_true", help="every house")
+    p.add_argument("--seed", type=int, default=None, help="default: house * 10 + raid")
+    p.add_argument("--max-captures", type=int, default=0, help="stop after this many captures (0: no limit)")
+    p.set_defaults(func=cmd_raid)
 
     p = sub.add_parser("bench", help="measure speed; prints JSON with --json")
     p.add_argument("what", choices=("load", "nav", "sensors"), help="what to measure")

@@ -5,6 +5,7 @@ room B is [6.2, 9] x [0, 4], a 1 m doorway joins them at x = 6.1, y in [1, 2]. F
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 from dataclasses import replace
@@ -149,23 +150,28 @@ def test_projection_matrix_maps_K_pixels_to_ndc():
     assert ndc[2] == pytest.approx((1 / 0.1 - 1 / 2.5) / (1 / 0.1 - 1 / 10.0) * 2 - 1)
 
 
-def test_points_projected_with_K_land_where_they_render(camera, world):
-    x, y, yaw = 2.0, 3.0, 0.0
-    cap = camera.capture(x, y, yaw)
-    walls, floors = _ids(world, "walls", "A/walls"), _ids(world, "floor", "A/floor")
-    # The line where room A's floor meets its east wall (x = 6), at y = 3.3: wall above, floor below.
-    u, v = camera.project(np.array([[6.0, 3.3, 0.0]]), x, y, yaw)[0]
-    col = cap.instance[:, int(round(u))]
-    boundary = np.flatnonzero(np.isin(col[:-1], list(walls)) & np.isin(col[1:], list(floors)))
-    assert len(boundary) == 1 and abs(boundary[0] + 0.5 - v) <= 1.0
-    # The doorway's jamb at y = 2: room A's wall piece ends at x = 6.1 where room B's begins.
-    x, y, yaw = 2.0, 1.5, 0.0
-    cap = camera.capture(x, y, yaw)
-    u, v = camera.project(np.array([[6.1, 2.0, 1.0]]), x, y, yaw)[0]
-    row = cap.instance[int(round(v))]
-    a_walls, b_walls = world.instance("A/walls").id, world.instance("B/walls").id
-    edges = np.flatnonzero((row[:-1] == a_walls) & (row[1:] == b_walls))
-    assert len(edges) == 1 and abs(edges[0] + 0.5 - u) <= 1.0
+@pytest.mark.parametrize("renderer", ["auto", "tiny"])
+def test_points_projected_with_K_land_where_they_render(renderer, world, box_house):
+    """Edges of known geometry fall within half a pixel of where K puts them, sub-pixel shifts
+    included (the floor is raised by fractions of a pixel)."""
+    with (_world(box_house, "tiny") if renderer == "tiny" else contextlib.nullcontext(world)) as w:
+        camera = SmartCamera(w, PROFILE.camera)
+        a_walls, a_floor, b_walls = (w.instance(n).id for n in ("A/walls", "A/floor", "B/walls"))
+        for lift in np.linspace(0.0, 0.006, 4):
+            # Where room A's floor meets its east wall (x = 6), at y = 3.3: wall above, floor below.
+            x, y, yaw = 2.0, 3.0, 0.0
+            cap = camera.capture(x, y, yaw, floor_z=lift)
+            u, v = camera.project(np.array([[6.0, 3.3, 0.0]]), x, y, yaw, floor_z=lift)[0]
+            col = cap.instance[:, int(round(u))]
+            boundary = np.flatnonzero((col[:-1] == a_walls) & (col[1:] == a_floor))
+            assert len(boundary) == 1 and abs(boundary[0] + 0.5 - v) <= 0.51
+            # The doorway's jamb at y = 2: room A's wall piece ends at x = 6.1 where room B's begins.
+            x, y, yaw = 2.0, 1.5 + lift, 0.0
+            cap = camera.capture(x, y, yaw)
+            u, v = camera.project(np.array([[6.1, 2.0, 1.0]]), x, y, yaw)[0]
+            row = cap.instance[int(round(v))]
+            edges = np.flatnonzero((row[:-1] == a_walls) & (row[1:] == b_walls))
+            assert len(edges) == 1 and abs(edges[0] + 0.5 - u) <= 0.51
 
 
 def _plane_depth(camera, x, y, yaw, row, plane_x=6.0):
@@ -420,7 +426,7 @@ def test_tiny_renderer_fallback_gives_a_similar_image(box_house, camera):
     with _world(box_house, "tiny") as w:
         assert w.renderer == "tiny"
         tiny = SmartCamera(w, PROFILE.camera).capture(*pose)
-    assert (egl.instance == tiny.instance).mean() > 0.97
+    assert (egl.instance == tiny.instance).mean() > 0.99
     both = np.isfinite(egl.depth) & np.isfinite(tiny.depth)
     assert np.median(np.abs(egl.depth[both] - tiny.depth[both])) < 0.01
     assert abs(_mean(egl.rgb) - _mean(tiny.rgb)) < 15

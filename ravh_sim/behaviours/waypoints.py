@@ -100,17 +100,18 @@ def room_order(rooms: list[str], mode: str, rng: random.Random) -> list[str]:
 
 def grid_nodes(layout: Layout, grid: Grid, start: Point, spacing: float = 0.5) -> list[Point]:
     """Lattice nodes every ``spacing`` m on reachable free cells, room by room (nearest room next),
-    sweeping each room row by row in alternating directions."""
+    sweeping each room row by row in alternating directions. Free strips the lattice misses (a narrow
+    corridor between lattice rows) get extra nodes until every reachable cell is within ``spacing``
+    of a node of its room."""
     reach = reachable_mask(grid, start)
     step = max(1, int(round(spacing / grid.resolution)))
+    lattice = np.zeros(grid.shape, bool)
+    lattice[step // 2::step, step // 2::step] = True
     by_room: dict[str, list[tuple[int, int]]] = {}
-    masks = room_masks(layout, grid)
-    for room_id, mask in masks.items():
-        lattice = np.zeros(grid.shape, bool)
-        lattice[step // 2::step, step // 2::step] = True
-        rows, cols = np.nonzero(lattice & mask & reach)
-        if len(rows):
-            by_room[room_id] = list(zip(rows.tolist(), cols.tolist()))
+    for room_id, mask in room_masks(layout, grid).items():
+        area = mask & reach
+        if area.any():
+            by_room[room_id] = _cover(area, lattice & area, step)
     nodes: list[Point] = []
     here = start
     remaining = dict(by_room)
@@ -123,6 +124,23 @@ def grid_nodes(layout: Layout, grid: Grid, start: Point, spacing: float = 0.5) -
         nodes += pts
         here = pts[-1]
     return nodes
+
+
+def _cover(area: np.ndarray, seeds: np.ndarray, step: int) -> list[tuple[int, int]]:
+    """``seeds`` plus farthest-point additions until every cell of ``area`` is within ``step`` cells."""
+    nodes = seeds.copy()
+    while True:
+        if nodes.any():
+            far = cv2.distanceTransform((~nodes).astype(np.uint8), cv2.DIST_L2, 5)
+        else:
+            far = np.full(area.shape, np.inf, np.float32)
+        far[~area] = 0
+        r, c = np.unravel_index(int(np.argmax(far)), far.shape)
+        if far[r, c] <= step:
+            break
+        nodes[r, c] = True
+    rows, cols = np.nonzero(nodes)
+    return list(zip(rows.tolist(), cols.tolist()))
 
 
 def _serpentine(cells: list[tuple[int, int]]) -> list[tuple[int, int]]:

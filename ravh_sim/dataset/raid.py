@@ -1,0 +1,140 @@
+"""``ravh raid``: the paper's data collection, run as three ROS processes (sim, behaviour, recorder).
+
+A raid is one house under one appearance preset, explored by one behaviour while the recorder writes
+the dataset. The presets are the paper's five; each becomes a settings file (saved in the output folder,
+so the raid can be rerun) passed to the sim node. Every raid gets its own ROS_DOMAIN_ID so raids on one
+machine never hear each other. Processes are stopped with SIGINT in the order that loses nothing:
+behaviour done -> recorder (flushes what it has) -> sim.
+"""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import yaml
+
+from ravh_sim.errors import UserError
+
+FAST_RTF = 4.0                   # --fast: sim seconds per wall second asked of the sim node
+POLL_S = 0.5
+
+
+@dataclass(frozen=True)
+class RaidPreset:
+    behaviour: str               # grid | wanderer
+    sun: str                     # day | sunset | night
+    lamps: str                   # on | off | random
+    ceiling: str
+    paint: str                   # default | random
+    models: str                  # default | random
+
+
+PRESETS = (
+    RaidPreset("grid", "day", "off", "on", "default", "default"),
+    RaidPreset("wanderer", "day", "off", "on", "default", "default"),
+    RaidPreset("wanderer", "day", "off", "off", "random", "random"),
+    RaidPreset("wanderer", "sunset", "random", "off", "random", "random"),
+    RaidPreset("wanderer", "night", "random", "on", "random", "random"),
+)
+
+
+def preset_settings(preset: RaidPreset, seed: int) -> dict:
+    """The settings file of a raid preset (keys as in config/default.yaml)."""
+    return {"seed": seed,
+            "lights": {"sun_angle": preset.sun, "ceiling": preset.ceiling, "lamps": preset.lamps},
+            "paint": {"walls": preset.paint, "floors": preset.paint},
+            "models": {"all": preset.models}}
+
+
+def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | None = None,
+             max_captures: int = 0, timeout: float = 3600.0, quiet: bool = False) -> dict:
+    """Run one raid into ``out``; returns its summary (also written to ``out/raid.json``)."""
+    if not 0 <= raid < len(PRESETS):
+        raise UserError(f"unknown raid {raid}; valid: {', '.join(map(str, range(len(PRESETS))))}")
+    preset = PRESETS[raid]
+    seed = house * 10 + raid if seed is None else seed
+    out.mkdir(parents=True, exist_ok=True)
+    settings_path = out / "raid_settings.yaml"
+    settings_path.write_text(yaml.safe_dump(preset_settings(preset, seed), sort_keys=False))
+    env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE=os.environ.get("ROS_AUTOMATIC_DISCOVERY_RANGE",
+                                                                          "LOCALHOST"),
+               ROS_DOMAIN_ID=str(1 + (os.getpid() * 7 + house * 5 + raid) % 200))
+    logs = out / "logs"
+    logs.mkdir(exist_ok=True)
+    rtf = FAST_RTF if fast else 1.0
+    behaviour_args = (["--order", "once", "--capture-period", "0.5"] if preset.behaviour == "wanderer"
+                      else ["--captures", "10"])
+    start = time.monotonic()
+    sim = _spawn(["sim", "--house", str(house), "--config", str(settings_path), "--rtf", str(rtf),
+                  "--camera-rate", "0"], env, logs / "sim.log")
+    recorder = _spawn(["recorder", "--out", str(out)], env, logs / "recorder.log")
+    behaviour = _spawn([preset.behaviour, "--log", str(logs / "behaviour_captures.jsonl"), *behaviour_args],
+                       env, logs / "behaviour.log")
+    captures = out / "captures.jsonl"
+    status = "done"
+    try:
+        while behaviour.poll() is None:
+            rows = _rows(captures)
+            if not quiet:
+                rooms = {r.get("room") for r in rows if r.get("room")}
+                print(f"\r[house {house} raid {raid}] {len(rows)} captures, {len(rooms)} rooms, "
+                      f"{time.monotonic() - start:.0f} s", end="", file=sys.stderr, flush=True)
+            if sim.poll() is not None or recorder.poll() is not None:
+                status = "a process died (see logs/)"
+                break
+            if max_captures and len(rows) >= max_captures:
+                status = f"stopped at {max_captures} captures"
+                break
+            if time.monotonic() - start > timeout:
+                status = f"timed out after {timeout:.0f} s"
+                break
+            time.sleep(POLL_S)
+    finally:
+        for proc in (behaviour, recorder, sim):
+            _stop(proc)
+    wall = time.monotonic() - start
+    rows = _rows(captures)
+    summary = {"house": house, "raid": raid, "preset": preset.__dict__, "seed": seed, "fast": fast,
+               "status": status if behaviour.returncode in (0, None) or status != "done"
+               else f"behaviour exited with {behaviour.returncode}",
+               "captures": len(rows), "rooms_visited": sorted({r["room"] for r in rows if r.get("room")}),
+               "wall_s": round(wall, 1),
+               "sim_s": round(rows[-1]["stamp"] - rows[0]["stamp"], 1) if len(rows) > 1 else 0.0}
+    (out / "raid.json").write_text(json.dumps(summary, indent=1))
+    if not quiet:
+        print(file=sys.stderr)
+    return summary
+
+
+def _spawn(args: list[str], env: dict[str, str], log: Path) -> subprocess.Popen:
+    with open(log, "w") as f:
+        return subprocess.Popen([sys.executable, "-m", "ravh_sim.cli", *args], env=env, stdout=f,
+                                stderr=subprocess.STDOUT)
+
+
+def _stop(proc: subprocess.Popen, timeout: float = 30.0) -> None:
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+        try:
+            proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+def _rows(path: Path) -> list[dict]:
+    if not path.exists():
+        return []
+    rows = []
+    for line in path.read_text().splitlines():
+        try:
+            rows.append(json.loads(line))
+        except ValueError:
+            break                                   # a line being written right now
+    return rows
