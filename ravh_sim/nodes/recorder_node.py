@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
+import rclpy.logging
 from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import OccupancyGrid, Odometry
 from rclpy.node import Node
@@ -311,8 +312,9 @@ class RecorderNode(Node):
         self.writer.close()
         if self.bag:
             self.bag.close()
-        self.get_logger().info(f"stopped: {self.captures} captures in {self.out}"
-                               + (f", {waiting} incomplete dropped" if waiting else ""))
+        # after SIGINT the context is gone and the node's logger cannot reach /rosout: log locally
+        rclpy.logging.get_logger("ravh_recorder.close").info(
+            f"stopped: {self.captures} captures in {self.out}" + (f", {waiting} incomplete dropped" if waiting else ""))
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:

@@ -1,0 +1,129 @@
+"""The ROS-free runtime and the message conversions the node uses."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from ravh_msgs_py import appearance
+from ravh_msgs_py.query import QueryError
+from ravh_sim.errors import UserError
+from ravh_sim.nav.grid import Grid
+from ravh_sim.nodes import convert
+from ravh_sim.runtime import OPTICAL_ROTATION, SimRuntime
+
+
+@pytest.fixture(scope="module")
+def runtime():
+    rt = SimRuntime(20, renderer="tiny")
+    yield rt
+    rt.close()
+
+
+def test_sensors_fall_due_at_their_rates(runtime):
+    agent = runtime.agents[0]
+    counts = {"camera": 0, "scan": 0, "odom": 0}
+    start = runtime.time
+    while runtime.time < start + 2.0:
+        runtime.step()
+        for what in counts:
+            counts[what] += runtime.due(agent, what)
+    assert counts == {"camera": pytest.approx(20, abs=1), "scan": pytest.approx(20, abs=1),
+                      "odom": pytest.approx(100, abs=1)}
+
+
+def test_commands_are_validated(runtime):
+    agent = runtime.agents[0]
+    for v, w in ((math.nan, 0.0), (0.0, math.inf), (1e6, 0.0), (0.0, -1e3)):
+        with pytest.raises(UserError, match="rejected"):
+            runtime.command(agent, v, w)
+    runtime.command(agent, 0.1, 0.0)
+    assert agent.robot.command == pytest.approx((0.1, 0.0))
+    runtime.command(agent, 0.0, 0.0)
+
+
+def test_map_to_odom_composes_with_odometry_to_the_true_pose(runtime):
+    from ravh_sim.robot.robot import compose
+    agent = runtime.agents[0]
+    runtime.command(agent, 0.2, 0.3)
+    runtime.step(480)
+    runtime.command(agent, 0.0, 0.0)
+    x, y, yaw = compose(runtime.map_to_odom(agent), agent.robot.odometry)
+    tx, ty, tyaw = agent.robot.pose
+    assert (x, y) == pytest.approx((tx, ty), abs=1e-9) and math.cos(yaw - tyaw) == pytest.approx(1.0)
+
+
+def test_optical_frame_rotation_is_rep103():
+    # camera_link x (forward) must become optical z; camera_link -y (right) optical x; -z (down) optical y
+    x, y, z, w = OPTICAL_ROTATION
+    rot = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                    [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                    [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    assert rot @ [0, 0, 1] == pytest.approx([1, 0, 0])            # optical z = link x
+    assert rot @ [1, 0, 0] == pytest.approx([0, -1, 0])           # optical x = link -y
+    assert rot @ [0, 1, 0] == pytest.approx([0, 0, -1])           # optical y = link -z
+
+
+def test_appearance_requests_change_only_what_they_name(runtime):
+    before = runtime.world.settings.to_dict()
+    reply = runtime.change_appearance({"doors": {"Door_1": "closed"}, "lights": {"ceiling": "off"}})
+    assert reply["ok"], reply
+    after = runtime.world.settings
+    assert after.doors["Door_1"] is False and not any(after.lights[lt.id] for lt in runtime.house.lights
+                                                       if lt.kind == "ceiling")
+    assert after.paint == before["paint"] and after.models == before["models"]
+    assert runtime.map_version >= 1
+    runtime.reset()
+    assert runtime.world.settings.to_dict() == runtime.initial.to_dict()
+
+
+@pytest.mark.parametrize("request_, code", [
+    ("{", "bad_json"), ({}, "bad_request"), ({"sun": 3}, "bad_request"), ({"sun_angle": 999}, "bad_request"),
+    ({"doors": {"Door_42": "open"}}, "unknown_id"), ({"lights": {"Light_0": "dim"}}, "bad_request"),
+    ({"paint": {"Bedroom_1": {"walls": "plaid"}}}, "bad_request"), ({"models": {"Bed_0": 99}}, "bad_request"),
+])
+def test_bad_appearance_requests_get_structured_errors(runtime, request_, code):
+    before = runtime.world.settings.to_dict()
+    reply = runtime.change_appearance(request_)
+    assert reply["ok"] is False and reply["error"]["code"] == code
+    assert runtime.world.settings.to_dict() == before                 # nothing half-applied
+
+
+def test_appearance_syntax_is_checked_offline():
+    assert appearance.parse('{"sun_angle": "night", "seed": 3}')["seed"] == 3
+    with pytest.raises(QueryError):
+        appearance.parse('{"models": {"Bed_0": -1}}')
+
+
+def test_image_conversion_round_trips():
+    rgb = np.random.default_rng(0).integers(0, 255, (4, 5, 3), dtype=np.uint8)
+    depth = np.linspace(0.5, 3, 20, dtype=np.float32).reshape(4, 5)
+    hdr = convert.header(12.25, "camera_optical_frame")
+    m = convert.image(rgb, "rgb8", hdr)
+    assert (m.width, m.height, m.step) == (5, 4, 15)
+    assert np.array_equal(np.frombuffer(m.data, np.uint8).reshape(4, 5, 3), rgb)
+    d = convert.image(depth, "32FC1", hdr)
+    assert np.array_equal(np.frombuffer(d.data, np.float32).reshape(4, 5), depth) and d.step == 20
+    assert (m.header.stamp.sec, m.header.stamp.nanosec) == (12, 250_000_000)
+
+
+def test_laser_scan_counting_rule():
+    ranges = np.full(360, np.inf, np.float32)
+    msg = convert.laser_scan(ranges, -math.pi, math.radians(1), 0.05, 30.0, 0.1, convert.header(0, "laser"))
+    assert len(msg.ranges) == round((msg.angle_max - msg.angle_min) / msg.angle_increment) + 1
+    assert math.isinf(msg.ranges[0])
+
+
+def test_occupancy_grid_conversion():
+    grid = Grid(np.array([[0, 100], [-1, 0]], np.int8), (1.5, -2.0), 0.05)
+    msg = convert.occupancy_grid(grid, convert.header(0, "map"), 0.0)
+    assert list(msg.data) == [0, 100, -1, 0] and (msg.info.width, msg.info.height) == (2, 2)
+    assert (msg.info.origin.position.x, msg.info.origin.position.y) == (1.5, -2.0)
+
+
+def test_camera_info_has_k_and_p():
+    k = np.array([[548.6, 0, 320], [0, 568.4, 240], [0, 0, 1]])
+    info = convert.camera_info(k, 640, 480, convert.header(0, "cam"))
+    assert list(info.k) == k.ravel().tolist() and info.p[3] == 0.0 and info.p[0] == 548.6
+    assert info.distortion_model == "plumb_bob" and len(info.d) == 5
