@@ -21,9 +21,15 @@ NAV_HOUSE = 23
 STEP_SAMPLES = 2400             # physics steps timed (10 s of simulated time at 240 Hz)
 
 
+BENCHES = ("load", "nav", "sensors", "node", "raid")
+
+
 def run(what: str, houses: list[int] | None = None) -> dict[str, Any]:
+    from ravh_sim import bench_ros
     benches: dict[str, Callable[..., dict[str, Any]]] = {"load": bench_load, "nav": bench_nav,
-                                                          "sensors": bench_sensors}
+                                                          "sensors": bench_sensors,
+                                                          "node": bench_ros.bench_node,
+                                                          "raid": bench_ros.bench_raid}
     return benches[what](houses=houses)
 
 

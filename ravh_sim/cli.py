@@ -13,6 +13,7 @@ from collections import Counter
 from pathlib import Path
 from typing import Callable
 
+from ravh_sim.bench import BENCHES
 from ravh_sim.errors import UserError
 from ravh_sim.nodes.launch import NODES
 from ravh_sim.nodes.launch import main as launch_node
@@ -199,6 +200,15 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_raid_summary(args: argparse.Namespace) -> int:
+    from ravh_sim.dataset.api import Dataset
+    from ravh_sim.dataset.summary import write_summary
+    dataset = Dataset(args.dataset)
+    write_summary(dataset, args.output)
+    print(f"wrote {args.output} ({len(dataset)} captures)")
+    return 0
+
+
 # ---------------------------------------------------------------------------- parser
 
 def _parser() -> argparse.ArgumentParser:
@@ -267,10 +277,15 @@ def _parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_raid)
 
     p = sub.add_parser("bench", help="measure speed; prints JSON with --json")
-    p.add_argument("what", choices=("load", "nav", "sensors"), help="what to measure")
+    p.add_argument("what", choices=BENCHES, help="what to measure")
     p.add_argument("--houses", type=int, nargs="*", default=None, help="houses to measure (default: all)")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_bench)
+
+    p = sub.add_parser("raid-summary", help="picture of a recorded dataset: trajectory on the plan, sample captures")
+    p.add_argument("dataset", type=Path, help="dataset folder written by the recorder")
+    p.add_argument("-o", "--output", type=Path, required=True, help="PNG file")
+    p.set_defaults(func=cmd_raid_summary)
     return parser
 
 

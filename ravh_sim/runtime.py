@@ -24,6 +24,7 @@ from ravh_sim.robot.robot import Robot, compose, relative
 from ravh_sim.robot.simulation import Simulation
 from ravh_sim.sensors.camera import Capture, CameraOptions, SmartCamera
 from ravh_sim.sensors.laser import Laser, Scan
+from ravh_sim.sensors.mount import LINK_TO_OPTICAL, quaternion_from_matrix
 from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.ground_truth import GroundTruth
@@ -32,7 +33,7 @@ from ravh_sim.world.scene import World
 from ravh_sim.world.settings import Resolved, load_settings, resolve
 
 # camera_link (x forward, z up) -> optical frame (z forward, x right, y down), REP 103
-OPTICAL_ROTATION = (-0.5, 0.5, -0.5, 0.5)
+OPTICAL_ROTATION = quaternion_from_matrix(LINK_TO_OPTICAL)
 
 # Commands beyond these magnitudes are refused as nonsense rather than clamped (clamping a
 # 1e9 m/s command would hide a unit bug in the sender); smaller overshoots are clamped by the robot.

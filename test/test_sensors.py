@@ -15,12 +15,14 @@ import numpy as np
 import pybullet as pb
 import pytest
 
+from ravh_msgs_py import names
 from ravh_sim.cli import main
 from ravh_sim.errors import UserError
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.sensors.camera import CameraOptions, SmartCamera, projection_from_K
 from ravh_sim.sensors.imaging import encode_jpeg, jpeg_roundtrip
 from ravh_sim.sensors.laser import Laser
+from ravh_sim.sensors.mount import LINK_TO_OPTICAL, quaternion_from_matrix
 from ravh_sim.world.appearance import Appearance, sun_light
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.house import HOUSE_FORMAT, house_from_dict
@@ -221,6 +223,8 @@ def test_camera_pose_is_the_pitched_optical_frame(camera):
     pitch = math.radians(spec.pitch_deg)
     assert rot[:, 2] == pytest.approx([0.0, math.cos(pitch), -math.sin(pitch)], abs=1e-9)   # z forward
     assert rot[:, 0] == pytest.approx([1.0, 0.0, 0.0], abs=1e-9)                           # x right
+    assert quaternion_from_matrix(LINK_TO_OPTICAL) == pytest.approx((-0.5, 0.5, -0.5, 0.5))
+    assert camera.camera_info.frame_id == names.CAMERA_OPTICAL_FRAME
 
 
 def test_instance_colours_use_the_footprint_mask_colours(camera, world, box_house):
@@ -271,6 +275,7 @@ def test_rep117_counting_and_infinities(world):
     near = Laser(world, replace(PROFILE.laser, range_min=2.2)).scan(2.0, 2.5, 0.0)
     assert near.ranges[0] == -np.inf                   # the west wall is 2 m behind
     assert near.ranges[180] == pytest.approx(4.0, abs=0.01)
+    assert scan.frame_id == names.LASER_FRAME
     assert scan.scan_time == pytest.approx(1 / PROFILE.laser.rate)
     assert scan.time_increment == pytest.approx(scan.scan_time / 271)
 

@@ -1,13 +1,15 @@
 """The lighting pass: daylight colour, switched-on lamps and the sky over pybullet's one-light render.
 
-pybullet draws one directional light with fixed shading (EGL: ``albedo * (0.75 + 0.25 n.l)``), so the
-rest of the house's light is added here, per pixel, from what the render gives: depth (3D points and
-normals through K), instance ids (which room a pixel belongs to) and the rendered colour (albedo is
-the colour divided by pybullet's own shading). Each switched-on light adds
-``albedo * colour * intensity * max(0, n.l) * falloff(d, range)`` to the pixels of its own room only,
-so light never leaks through walls. The room of a pixel is the room of the instance seen there: exact
-on walls, which lie on room boundaries where a floor-plan lookup is ambiguous. Light is computed on a
-half-resolution grid and upsampled (it varies smoothly), which keeps the pass at a few milliseconds.
+pybullet draws one directional light with fixed shading (EGL: ``albedo * (0.75 + 0.25 n.l)``; the
+EGL plugin ignores lightColor and the ambient/diffuse/specular coefficients, measured), so daylight
+colour and every other light are added here, for both renderers, per pixel, from what the render
+gives: depth (3D points and normals through K), instance ids (which room a pixel belongs to) and
+the rendered colour (albedo is the colour divided by pybullet's own shading). Each switched-on light
+adds ``albedo * colour * intensity * max(0, n.l) * falloff(d, range)`` to the pixels of its own room
+only, so light never leaks through walls. The room of a pixel is the room of the instance seen
+there: exact on walls, which lie on room boundaries where a floor-plan lookup is ambiguous. Light is
+computed on a half-resolution grid and upsampled (it varies smoothly), which keeps the pass at a few
+milliseconds.
 
 The sky (daylight colour from :func:`sun_light`) fills the background and the windows' panes: house
 walls are not cut at windows and the window models' glass sits inside the wall, so the wall pixels

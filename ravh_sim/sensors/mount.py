@@ -1,8 +1,8 @@
 """Where a sensor sits: from a robot pose on the floor to the sensor's pose in the house frame.
 
 A robot pose is (x, y, yaw) on the floor (REP 103, z up); sensors are mounted at a height above that
-floor, possibly ahead of the base centre and pitched down. The frame names the ROS layer publishes
-live here too, so the camera, the laser and the TF tree agree.
+floor, possibly ahead of the base centre and pitched down. Frame names come from
+:mod:`ravh_msgs_py.names`, so the images, the scans and the TF tree agree.
 """
 from __future__ import annotations
 
@@ -10,14 +10,14 @@ import math
 
 import numpy as np
 
+from ravh_msgs_py.names import CAMERA_OPTICAL_FRAME, LASER_FRAME
 from ravh_sim.world.scene import World
 
-BASE_FRAME = "base_link"
-CAMERA_FRAME = "camera_link"                  # x forward, y left, z up (REP 103)
-CAMERA_OPTICAL_FRAME = "camera_optical_frame"  # x right, y down, z forward (REP 103 optical)
-LASER_FRAME = "laser"
+__all__ = ["CAMERA_OPTICAL_FRAME", "LASER_FRAME", "LINK_TO_OPTICAL", "floor_at", "mount_position",
+           "mount_rotation", "quaternion_from_matrix"]
 
-# Columns: the optical frame's axes expressed in the camera_link frame.
+# Columns: the optical frame's axes (x right, y down, z forward) in the camera_link frame; as a
+# quaternion (x, y, z, w) this is the usual (-0.5, 0.5, -0.5, 0.5).
 LINK_TO_OPTICAL = np.array([[0.0, 0.0, 1.0],
                             [-1.0, 0.0, 0.0],
                             [0.0, -1.0, 0.0]])
