@@ -16,7 +16,7 @@ import json
 import math
 from typing import Any
 
-from ravh_msgs_py.query import BAD_JSON, BAD_REQUEST, QueryError
+from ravh_msgs_py.query import BAD_REQUEST, QueryError, decode
 
 KEYS = ("sun_angle", "lights", "doors", "paint", "models", "seed", "randomise")
 SUN_WORDS = ("day", "sunset", "night", "random")
@@ -32,13 +32,7 @@ def request(**changes: Any) -> str:
 
 def parse(text: str | bytes | dict) -> dict[str, Any]:
     """Check the syntax of an appearance request (names are checked against the house later)."""
-    if isinstance(text, dict):
-        data = text
-    else:
-        try:
-            data = json.loads(text)
-        except (ValueError, TypeError) as e:
-            raise QueryError(BAD_JSON, f"request is not valid JSON: {e}") from None
+    data = decode(text)
     if not isinstance(data, dict) or not data:
         raise QueryError(BAD_REQUEST, 'expected a non-empty JSON object like {"sun_angle": "night"}',
                          list(KEYS))

@@ -83,15 +83,19 @@ def request(query: str, **args: Any) -> str:
     return json.dumps({"query": query, **args})
 
 
+def decode(text: str | bytes | dict) -> Any:
+    """A request as decoded JSON (a dict passes through); bad JSON raises :class:`QueryError`."""
+    if isinstance(text, dict):
+        return text
+    try:
+        return json.loads(text)
+    except (ValueError, TypeError) as e:
+        raise QueryError(BAD_JSON, f"request is not valid JSON: {e}") from None
+
+
 def parse_request(text: str | bytes | dict) -> tuple[str, dict[str, Any]]:
     """Validate a request; returns (query name, arguments) or raises :class:`QueryError`."""
-    if isinstance(text, dict):
-        data = text
-    else:
-        try:
-            data = json.loads(text)
-        except (ValueError, TypeError) as e:
-            raise QueryError(BAD_JSON, f"request is not valid JSON: {e}") from None
+    data = decode(text)
     if not isinstance(data, dict):
         raise QueryError(BAD_REQUEST, 'request must be a JSON object like {"query": "rooms"}')
     name = data.get("query")
