@@ -117,7 +117,7 @@ class Dataset:
     def objects_in(self, sample: Sample, min_pixels: int = MIN_PIXELS) -> Counter[str]:
         """Object type -> how many distinct objects of it cover at least ``min_pixels`` of the image."""
         pixels = np.bincount(sample.instance.ravel())
-        seen = Counter()
+        seen: Counter[str] = Counter()
         for i in np.flatnonzero(pixels >= min_pixels):
             row = self.instances.get(int(i))
             if row is not None and row["kind"] == "object":

@@ -23,6 +23,8 @@ from ravh_sim.errors import UserError
 
 FAST_RTF = 4.0                   # --fast: sim seconds per wall second asked of the sim node
 POLL_S = 0.5
+RECORDER_START_S = 120.0         # the recorder is ready once the sim's footprint reached it
+DISCOVERY_S = 2.0
 
 
 @dataclass(frozen=True)
@@ -73,7 +75,12 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
     start = time.monotonic()
     sim = _spawn(["sim", "--house", str(house), "--config", str(settings_path), "--rtf", str(rtf),
                   "--camera-rate", "0"], env, logs / "sim.log")
-    recorder = _spawn(["recorder", "--out", str(out)], env, logs / "recorder.log")
+    raid_meta = {"house": house, "raid": raid, "preset": preset.__dict__, "seed": seed, "fast": fast}
+    recorder = _spawn(["recorder", "--out", str(out), "--raid", json.dumps(raid_meta)], env,
+                      logs / "recorder.log")
+    _wait_for(lambda: (out / "dataset.json").exists() or sim.poll() is not None
+              or recorder.poll() is not None, RECORDER_START_S)
+    time.sleep(DISCOVERY_S)                      # let the recorder's capture subscriptions match
     behaviour = _spawn([preset.behaviour, "--log", str(logs / "behaviour_captures.jsonl"), *behaviour_args],
                        env, logs / "behaviour.log")
     captures = out / "captures.jsonl"
@@ -100,8 +107,7 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
             _stop(proc)
     wall = time.monotonic() - start
     rows = _rows(captures)
-    summary = {"house": house, "raid": raid, "preset": preset.__dict__, "seed": seed, "fast": fast,
-               "status": status if behaviour.returncode in (0, None) or status != "done"
+    summary = {**raid_meta, "status": status if behaviour.returncode in (0, None) or status != "done"
                else f"behaviour exited with {behaviour.returncode}",
                "captures": len(rows), "rooms_visited": sorted({r["room"] for r in rows if r.get("room")}),
                "wall_s": round(wall, 1),
@@ -110,6 +116,12 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
     if not quiet:
         print(file=sys.stderr)
     return summary
+
+
+def _wait_for(condition, timeout: float) -> None:
+    end = time.monotonic() + timeout
+    while not condition() and time.monotonic() < end:
+        time.sleep(0.2)
 
 
 def _spawn(args: list[str], env: dict[str, str], log: Path) -> subprocess.Popen:

@@ -14,11 +14,11 @@ import cv2
 import numpy as np
 
 from ravh_sim.dataset.api import Dataset, Sample
-from ravh_sim.viz.plan import render_plan, room_color, write_plan
+from ravh_sim.viz.plan import Plan, render_plan, room_color, write_plan
 
 COLS, ROWS = 4, 3                      # contact sheet tiles
 TILE_W, TILE_H = 320, 240              # RGB size in a tile; depth and mask are half that, side by side
-HEAD_H = 46                            # tile header band: number, room, time
+HEAD_H = 46                            # tile header band: number, room, capture, objects in view
 GAP = 14
 SHEET_HEAD = 64                        # band above the tiles: the sheet's title and the depth scale
 DEPTH_RANGE_M = (0.0, 8.0)             # colour scale of the depth tiles (turbo, black = no depth)
@@ -69,7 +69,7 @@ def _plan(dataset: Dataset, picks: list[Sample], sheet_hw: tuple[int, int]) -> t
     title = (f"House {house.number} raid — {len(samples)} captures, "
              f"{len(dataset.rooms_visited())}/{dataset.count_rooms()} rooms, {t1 - t0:.0f} s")
 
-    def draw(px_per_m: float):
+    def draw(px_per_m: float) -> Plan:
         return render_plan(house, door_open=settings.doors, models=settings.models,
                            path=path if len(path) >= 2 else None, poses=poses or None,
                            px_per_m=px_per_m, title=title)

@@ -31,7 +31,7 @@ from ravh_sim.nav.follower import PathFollower
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.planner import Path as PlannedPath
 from ravh_sim.nav.planner import plan_path
-from ravh_sim.nodes.common import COMMAND_QOS, LATCHED_QOS, STATE_QOS
+from ravh_sim.nodes.common import COMMAND_QOS, LATCHED_QOS, STATE_QOS, quiet_after_shutdown
 from ravh_sim.robot.profile import load_profile
 
 FIRST_AGENT = "robot"            # the default settings' agent; other agents' topics are prefixed
@@ -125,6 +125,7 @@ class BehaviourNode(Node):
         raise UserError(f"no sim node answered within {STARTUP_TIMEOUT_S:.0f} s "
                         f"(is `ravh sim` running on ROS_DOMAIN_ID {os.environ.get('ROS_DOMAIN_ID', '0')}?)")
 
+    @quiet_after_shutdown
     def _tick(self) -> None:
         now = self.get_clock().now().nanoseconds * 1e-9
         dt = 1.0 / CONTROL_HZ if self._last_t is None else now - self._last_t

@@ -6,6 +6,7 @@ subscribers get them. Nodes stop on SIGINT (Fast DDS leaves shared-memory files 
 """
 from __future__ import annotations
 
+import functools
 import os
 import sys
 from typing import Callable
@@ -33,6 +34,19 @@ def use_large_message_transport() -> None:
     """
     if "FASTRTPS_DEFAULT_PROFILES_FILE" not in os.environ and FASTDDS_PROFILE.exists():
         os.environ["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(FASTDDS_PROFILE)
+
+
+def quiet_after_shutdown(callback: Callable) -> Callable:
+    """Wrap a timer/subscription callback of a Node: once SIGINT has shut the context down, a publish
+    that was under way raises; that is the node stopping, not an error worth a traceback."""
+    @functools.wraps(callback)
+    def wrapper(self, *args, **kwargs):
+        try:
+            return callback(self, *args, **kwargs)
+        except Exception:
+            if self.context.ok():
+                raise
+    return wrapper
 
 
 def run_node(make_node: Callable[[list[str]], object], argv: list[str] | None = None) -> int:

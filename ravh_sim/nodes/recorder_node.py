@@ -26,7 +26,7 @@ import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 import rclpy.logging
@@ -54,19 +54,27 @@ NS = 1_000_000_000
 PENDING_TIMEOUT_S = 10.0      # wall seconds a stamp's parts wait for the rest of their capture
 MAX_PENDING = 32              # stamps buffered at most (periodic frames without an event go first)
 
-# Per-agent topics: part -> (base name, message type, QoS, in the dataset, in the bag, per capture).
-# Parts "per capture" are buffered by stamp and bagged only for captures; the others stream through.
-PARTS: dict[str, tuple[str, type, QoSProfile, bool, bool, bool]] = {
-    "rgb": (n.COLOR_IMAGE, Image, SENSOR_QOS, True, False, True),
-    "jpeg": (n.COLOR_COMPRESSED, CompressedImage, SENSOR_QOS, False, True, True),
-    "depth": (n.DEPTH_IMAGE, Image, SENSOR_QOS, True, True, True),
-    "instance": (n.INSTANCE_IMAGE, Image, SENSOR_QOS, True, True, True),
-    "rgb_info": (n.COLOR_INFO, CameraInfo, SENSOR_QOS, True, True, True),
-    "depth_info": (n.DEPTH_INFO, CameraInfo, SENSOR_QOS, False, True, True),
-    "scan": (n.SCAN, LaserScan, SENSOR_QOS, True, True, False),
-    "odom": (n.ODOM, Odometry, STATE_QOS, False, True, False),
-    "gt_pose": (n.GROUND_TRUTH_POSE, PoseStamped, STATE_QOS, False, True, False),
-    "event": (n.CAPTURE_EVENT, String, STATE_QOS, True, True, False),
+class Part(NamedTuple):
+    """A per-agent topic the recorder subscribes to."""
+    base: str                 # name in ravh_msgs_py.names (prefixed for agents after the first)
+    msg_type: type
+    qos: QoSProfile
+    dataset: bool             # needed for the dataset (part of a capture's set)
+    bag: bool                 # recorded in the bag
+    per_capture: bool         # camera: waits by stamp, bagged only for captures (else streamed)
+
+
+PARTS: dict[str, Part] = {
+    "rgb": Part(n.COLOR_IMAGE, Image, SENSOR_QOS, True, False, True),
+    "jpeg": Part(n.COLOR_COMPRESSED, CompressedImage, SENSOR_QOS, False, True, True),
+    "depth": Part(n.DEPTH_IMAGE, Image, SENSOR_QOS, True, True, True),
+    "instance": Part(n.INSTANCE_IMAGE, Image, SENSOR_QOS, True, True, True),
+    "rgb_info": Part(n.COLOR_INFO, CameraInfo, SENSOR_QOS, True, True, True),
+    "depth_info": Part(n.DEPTH_INFO, CameraInfo, SENSOR_QOS, False, True, True),
+    "scan": Part(n.SCAN, LaserScan, SENSOR_QOS, True, True, False),
+    "odom": Part(n.ODOM, Odometry, STATE_QOS, False, True, False),
+    "gt_pose": Part(n.GROUND_TRUTH_POSE, PoseStamped, STATE_QOS, False, True, False),
+    "event": Part(n.CAPTURE_EVENT, String, STATE_QOS, True, True, False),
 }
 # Latched, not per agent: name -> (message type, in the dataset).
 LATCHED: dict[str, tuple[type, bool]] = {
@@ -208,10 +216,11 @@ class RecorderNode(Node):
         self.writer = DatasetWriter(out)
         self.bag = BagWriter(out / layout.BAG_DIR) if bag else None
         self.worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="ravh_recorder_write")
-        self.parts = {k: v for k, v in PARTS.items() if v[3] or (bag and v[4])}
-        self.matcher = StampMatcher({k for k, v in self.parts.items() if v[5]} | {"event", "scan"})
+        self.parts = {k: p for k, p in PARTS.items() if p.dataset or (bag and p.bag)}
+        self.matcher = StampMatcher({k for k, p in self.parts.items() if p.per_capture or p.dataset})
         self.agent: str | None = None
         self.captures = 0
+        self.log = self.get_logger()
         self.topics: dict[str, str] = {}              # part -> resolved topic name
         for topic, (msg_type, in_dataset) in LATCHED.items():
             if in_dataset or bag:
@@ -220,7 +229,7 @@ class RecorderNode(Node):
                 if self.bag:
                     self.bag.add_topic(sub.topic_name, msg_type, latched=True)
                 self.topics[topic] = sub.topic_name
-        self.get_logger().info(f"waiting for {n.GROUND_TRUTH} to learn the house and its agents")
+        self.log.info(f"waiting for {n.GROUND_TRUTH} to learn the house and its agents")
 
     # ------------------------------------------------------------------ set-up once the world is known
     def _start(self, footprint: dict[str, Any]) -> None:
@@ -232,14 +241,15 @@ class RecorderNode(Node):
             raise UserError(f"unknown agent {agent!r}; the sim has {', '.join(agents)}")
         self.agent = agent
         self._submit(self.writer.write_meta, footprint["house"], [agent], self.raid, self.bag is not None)
-        for part, (base, msg_type, qos, _, in_bag, _) in self.parts.items():
-            name = n.agent_name(base, agent, agent == agents[0])
-            sub = self.create_subscription(msg_type, name, lambda d, p=part: self._on_part(p, d), qos, raw=True)
-            self.topics[part] = sub.topic_name
-            if self.bag and in_bag:
-                self.bag.add_topic(sub.topic_name, msg_type, latched=False)
-        self.get_logger().info(f"recording agent {agent} of house {footprint['house']} into {self.out}"
-                               f" ({'with' if self.bag else 'no'} bag)")
+        for key, part in self.parts.items():
+            name = n.agent_name(part.base, agent, agent == agents[0])
+            sub = self.create_subscription(part.msg_type, name, lambda d, k=key: self._on_part(k, d), part.qos,
+                                           raw=True)
+            self.topics[key] = sub.topic_name
+            if self.bag and part.bag:
+                self.bag.add_topic(sub.topic_name, part.msg_type, latched=False)
+        self.log.info(f"recording agent {agent} of house {footprint['house']} into {self.out}"
+                      f" ({'with' if self.bag else 'no'} bag)")
 
     # ------------------------------------------------------------------ callbacks
     def _now_ns(self) -> int:
@@ -256,36 +266,35 @@ class RecorderNode(Node):
         elif topic == n.MAP:
             self._submit(self.writer.write_map, grid_of(deserialize_message(data, OccupancyGrid)))
 
-    def _on_part(self, part: str, data: bytes) -> None:
-        now_ns = self._now_ns()
-        per_capture, in_bag = self.parts[part][5], self.parts[part][4]
-        if self.bag and in_bag and not per_capture:
-            self.bag.write(self.topics[part], now_ns, data)
-        if part == "event":
+    def _on_part(self, key: str, data: bytes) -> None:
+        now_ns, part = self._now_ns(), self.parts[key]
+        if self.bag and part.bag and not part.per_capture:
+            self.bag.write(self.topics[key], now_ns, data)
+        if key == "event":
             event = json.loads(deserialize_message(data, String).data)
             if event.get("agent") != self.agent:
                 return
             stamp, value = event_stamp_ns(float(event["stamp"])), event
-        elif part in self.matcher.required:
+        elif key in self.matcher.required:
             stamp, value = header_stamp_ns(data), (now_ns, data)
         else:
             return
-        parts = self.matcher.add(stamp, part, value, time.monotonic())
+        parts = self.matcher.add(stamp, key, value, time.monotonic())
         while self.matcher.lost:
-            self.get_logger().warning(f"capture at t={self.matcher.lost.pop(0) / NS:.3f} s incomplete: dropped")
+            self.log.warning(f"capture at t={self.matcher.lost.pop(0) / NS:.3f} s incomplete: dropped")
         if parts is not None:
             self._complete(parts)
 
     def _complete(self, parts: dict[str, Any]) -> None:
         if self.bag:
-            for part, value in parts.items():
-                if self.parts[part][4] and self.parts[part][5]:
-                    self.bag.write(self.topics[part], *value)
+            for key, value in parts.items():
+                if self.parts[key].bag and self.parts[key].per_capture:
+                    self.bag.write(self.topics[key], *value)
         self._submit(self._write_capture, parts)
 
     def _write_capture(self, parts: dict[str, Any]) -> None:
         """Worker thread: deserialize what the dataset keeps and write it."""
-        msgs = {p: deserialize_message(parts[p][1], self.parts[p][1]) for p in
+        msgs = {k: deserialize_message(parts[k][1], self.parts[k].msg_type) for k in
                 ("rgb", "depth", "instance", "rgb_info", "scan")}
         event, scan = parts["event"], msgs["scan"]
         index = self.writer.write_capture(
@@ -296,25 +305,26 @@ class RecorderNode(Node):
              "range_min": scan.range_min, "range_max": scan.range_max},
             camera_dict(msgs["rgb_info"]))
         self.captures = index + 1
-        self.get_logger().info(f"capture {index} at t={event['stamp']:.2f} s in {event['room']}")
+        self.log.info(f"capture {index} at t={event['stamp']:.2f} s in {event['room']}")
 
     def _submit(self, fn: Callable[..., object], *args: Any) -> None:
         self.worker.submit(fn, *args).add_done_callback(self._report)
 
     def _report(self, future: Future) -> None:
         if future.exception() is not None:
-            self.get_logger().error(f"dataset write failed: {future.exception()!r}")
+            self.log.error(f"dataset write failed: {future.exception()!r}")
 
     def close(self) -> None:
         """Finish queued writes, then close the dataset and the bag (SIGINT lands here)."""
+        # after SIGINT the context is gone and the node's logger cannot reach /rosout: log locally
+        self.log = rclpy.logging.get_logger("ravh_recorder.close")
         waiting = sum("event" in e.parts for e in self.matcher.pending.values())
         self.worker.shutdown(wait=True)
         self.writer.close()
         if self.bag:
             self.bag.close()
-        # after SIGINT the context is gone and the node's logger cannot reach /rosout: log locally
-        rclpy.logging.get_logger("ravh_recorder.close").info(
-            f"stopped: {self.captures} captures in {self.out}" + (f", {waiting} incomplete dropped" if waiting else ""))
+        self.log.info(f"stopped: {self.captures} captures in {self.out}"
+                      + (f", {waiting} incomplete dropped" if waiting else ""))
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:

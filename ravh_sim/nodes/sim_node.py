@@ -28,7 +28,8 @@ from std_srvs.srv import Trigger
 from ravh_msgs_py import names as n
 from ravh_sim.errors import UserError
 from ravh_sim.nodes import convert
-from ravh_sim.nodes.common import COMMAND_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, run_node
+from ravh_sim.nodes.common import (COMMAND_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, quiet_after_shutdown,
+                                   run_node)
 from ravh_sim.runtime import Agent, Rates, SimRuntime
 from ravh_sim.sensors.camera import CameraOptions
 from ravh_sim.sensors.imaging import encode_jpeg
@@ -131,6 +132,7 @@ class SimNode(Node):
                 lambda req, res, a=agent: self._on_capture(a, res))
 
     # ------------------------------------------------------------------ stepping
+    @quiet_after_shutdown
     def _tick(self) -> None:
         """Advance sim time towards wall time x RTF, publishing whatever falls due on the way."""
         rt = self.runtime
