@@ -184,7 +184,7 @@ def cmd_raid(args: argparse.Namespace) -> int:
     for house in houses:
         out = args.out / f"house{house:02d}_raid{args.raid}" if args.all else args.out
         results.append(run_raid(house, args.raid, out, fast=args.fast, seed=args.seed,
-                                max_captures=args.max_captures))
+                                max_captures=args.max_captures, max_nodes=args.max_nodes))
     print(json.dumps(results if args.all else results[0], indent=1))
     return 0 if all(r["status"] == "done" or r["status"].startswith("stopped") for r in results) else 1
 
@@ -274,6 +274,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--all", action="store_true", help="every house")
     p.add_argument("--seed", type=int, default=None, help="default: house * 10 + raid")
     p.add_argument("--max-captures", type=int, default=0, help="stop after this many captures (0: no limit)")
+    p.add_argument("--max-nodes", type=int, default=0, help="grid raids: visit only this many nodes (0: all)")
     p.set_defaults(func=cmd_raid)
 
     p = sub.add_parser("bench", help="measure speed; prints JSON with --json")

@@ -100,9 +100,8 @@ def room_order(rooms: list[str], mode: str, rng: random.Random) -> list[str]:
 
 def grid_nodes(layout: Layout, grid: Grid, start: Point, spacing: float = 0.5) -> list[Point]:
     """Lattice nodes every ``spacing`` m on reachable free cells, room by room (nearest room next),
-    sweeping each room row by row in alternating directions. Free strips the lattice misses (a narrow
-    corridor between lattice rows) get extra nodes until every reachable cell is within ``spacing``
-    of a node of its room."""
+    each room toured nearest node first. Free strips the lattice misses (a narrow corridor between
+    lattice rows) get extra nodes until every reachable cell is within ``spacing`` of a node of its room."""
     reach = reachable_mask(grid, start)
     step = max(1, int(round(spacing / grid.resolution)))
     lattice = np.zeros(grid.shape, bool)
@@ -117,10 +116,7 @@ def grid_nodes(layout: Layout, grid: Grid, start: Point, spacing: float = 0.5) -
     remaining = dict(by_room)
     while remaining:
         room_id = min(remaining, key=lambda rid: _distance_to_cells(grid, here, remaining[rid]))
-        cells = _serpentine(remaining.pop(room_id))
-        pts = [grid.center_of(r, c) for r, c in cells]
-        if math.dist(here, pts[-1]) < math.dist(here, pts[0]):
-            pts.reverse()
+        pts = _tour([grid.center_of(r, c) for r, c in remaining.pop(room_id)], here)
         nodes += pts
         here = pts[-1]
     return nodes
@@ -143,15 +139,17 @@ def _cover(area: np.ndarray, seeds: np.ndarray, step: int) -> list[tuple[int, in
     return list(zip(rows.tolist(), cols.tolist()))
 
 
-def _serpentine(cells: list[tuple[int, int]]) -> list[tuple[int, int]]:
-    rows: dict[int, list[int]] = {}
-    for r, c in cells:
-        rows.setdefault(r, []).append(c)
-    out = []
-    for i, r in enumerate(sorted(rows)):
-        cols = sorted(rows[r], reverse=bool(i % 2))
-        out += [(r, c) for c in cols]
-    return out
+def _tour(points: list[Point], start: Point) -> list[Point]:
+    """Greedy nearest-neighbour order from ``start``: on a lattice it walks neighbour to neighbour."""
+    left = np.array(points)
+    order: list[Point] = []
+    here = np.array(start)
+    while len(left):
+        k = int(np.argmin(np.sum((left - here) ** 2, axis=1)))
+        here = left[k]
+        order.append((float(here[0]), float(here[1])))
+        left = np.delete(left, k, axis=0)
+    return order
 
 
 def _distance_to_cells(grid: Grid, xy: Point, cells: list[tuple[int, int]]) -> float:

@@ -55,7 +55,7 @@ def preset_settings(preset: RaidPreset, seed: int) -> dict:
 
 
 def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | None = None,
-             max_captures: int = 0, timeout: float = 3600.0, quiet: bool = False) -> dict:
+             max_captures: int = 0, max_nodes: int = 0, timeout: float = 3600.0, quiet: bool = False) -> dict:
     """Run one raid into ``out``; returns its summary (also written to ``out/raid.json``)."""
     if not 0 <= raid < len(PRESETS):
         raise UserError(f"unknown raid {raid}; valid: {', '.join(map(str, range(len(PRESETS))))}")
@@ -71,7 +71,7 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
     logs.mkdir(exist_ok=True)
     rtf = FAST_RTF if fast else 1.0
     behaviour_args = (["--order", "once", "--capture-period", "0.5"] if preset.behaviour == "wanderer"
-                      else ["--captures", "10"])
+                      else ["--captures", "10", "--max-nodes", str(max_nodes)])
     start = time.monotonic()
     sim = _spawn(["sim", "--house", str(house), "--config", str(settings_path), "--rtf", str(rtf),
                   "--camera-rate", "0"], env, logs / "sim.log")
