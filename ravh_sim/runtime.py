@@ -26,7 +26,7 @@ from ravh_sim.sensors.camera import Capture, CameraOptions, SmartCamera
 from ravh_sim.sensors.laser import Laser, Scan
 from ravh_sim.sensors.mount import LINK_TO_OPTICAL, quaternion_from_matrix
 from ravh_sim.world.appearance import Appearance
-from ravh_sim.world.footprint import make_footprint
+from ravh_sim.world.footprint import load_footprint, make_footprint
 from ravh_sim.world.ground_truth import GroundTruth
 from ravh_sim.world.house import House, load_house
 from ravh_sim.world.scene import World
@@ -66,11 +66,17 @@ class SimRuntime:
 
     def __init__(self, house: int | House, config: str | Path | None = None, seed: int | None = None,
                  renderer: str = "auto", rates: Rates | None = None,
-                 camera_options: CameraOptions | None = None) -> None:
-        self.house = house if isinstance(house, House) else load_house(house)
+                 camera_options: CameraOptions | None = None, footprint: str | Path | None = None) -> None:
+        """``footprint``: rebuild exactly the world a footprint file describes (its house and its
+        resolved settings); ``house``, ``config`` and ``seed`` are then ignored."""
         self.config_source = str(config or "config/default.yaml")
         self.settings_doc = load_settings(config)
-        resolved = resolve(self.settings_doc, self.house, seed, self.config_source)
+        if footprint:
+            number, resolved = load_footprint(Path(footprint))
+            self.house = load_house(number)
+        else:
+            self.house = house if isinstance(house, House) else load_house(house)
+            resolved = resolve(self.settings_doc, self.house, seed, self.config_source)
         self.initial = Resolved.from_dict(resolved.to_dict())
         self.world = World(self.house, resolved, renderer=renderer)
         self.appearance = Appearance(self.world)

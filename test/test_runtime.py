@@ -127,3 +127,24 @@ def test_camera_info_has_k_and_p():
     info = convert.camera_info(k, 640, 480, convert.header(0, "cam"))
     assert list(info.k) == k.ravel().tolist() and info.p[3] == 0.0 and info.p[0] == 548.6
     assert info.distortion_model == "plumb_bob" and len(info.d) == 5
+
+
+def test_a_footprint_rebuilds_the_same_world(runtime, tmp_path):
+    from ravh_sim.world.footprint import dump_footprint, write_footprint
+    runtime.change_appearance({"models": {"Bed_0": 2}, "paint": {"Bedroom_1": {"walls": "brick"}}})
+    path = tmp_path / "fp.json"
+    write_footprint(runtime.footprint(), path)
+    again = SimRuntime(1, footprint=path, renderer="tiny")
+    try:
+        assert again.house.number == 20
+        assert dump_footprint(again.footprint()) == dump_footprint(runtime.footprint())
+        a, b = runtime.agents[0], again.agents[0]
+        pose = (-2.0, 1.0, 0.3)
+        a.robot.teleport(*pose)
+        b.robot.teleport(*pose)
+        assert np.array_equal(runtime.scan(a).ranges, again.scan(b).ranges)
+        ca, cb = runtime.capture(a), again.capture(b)
+        assert np.array_equal(ca.instance, cb.instance) and np.array_equal(ca.rgb, cb.rgb)
+    finally:
+        again.close()
+        runtime.reset()

@@ -45,7 +45,7 @@ CMD_TIMEOUT_S = 0.5                     # stop a robot whose commands stop arriv
 WARN_THROTTLE_S = 2.0
 
 PARAMETERS: dict[str, Any] = {
-    "house": 15, "seed": -1, "config": "", "renderer": "auto", "real_time_factor": 1.0,
+    "house": 15, "seed": -1, "config": "", "footprint": "", "renderer": "auto", "real_time_factor": 1.0,
     "camera_rate": 10.0, "scan_rate": 10.0, "odom_rate": 50.0, "clock_rate": 100.0,
     "cmd_vel_stamped": False, "jpeg_quality": 90,
 }
@@ -63,7 +63,7 @@ class SimNode(Node):
         self.runtime = SimRuntime(int(p["house"]), p["config"] or None, None if p["seed"] < 0 else int(p["seed"]),
                                   renderer=p["renderer"],
                                   rates=Rates(p["camera_rate"], p["scan_rate"], p["odom_rate"], p["clock_rate"]),
-                                  camera_options=CameraOptions())
+                                  camera_options=CameraOptions(), footprint=p["footprint"] or None)
         rt = self.runtime
         self.get_logger().info(
             f"house {rt.house.number}: {len(rt.house.rooms)} rooms, {len(rt.house.objects)} objects, "
@@ -334,6 +334,7 @@ def parse_args(argv: list[str]) -> dict[str, Any]:
     p.add_argument("--house", type=int)
     p.add_argument("--seed", type=int)
     p.add_argument("--config")
+    p.add_argument("--footprint", help="rebuild the world of this footprint file (house and settings)")
     p.add_argument("--renderer", choices=("auto", "egl", "tiny"))
     p.add_argument("--rtf", "--real-time-factor", dest="real_time_factor", type=float,
                    help="sim seconds per wall second; 0 = as fast as possible (default 1)")
