@@ -93,14 +93,8 @@ def bench_load(houses: list[int] | None = None) -> dict[str, Any]:
 
 
 def _bare_client() -> None:
-    import pkgutil
-
-    import pybullet as pb
-    client = pb.connect(pb.DIRECT)
-    loader = pkgutil.get_loader("eglRenderer")
-    if loader is not None:
-        pb.loadPlugin(loader.get_filename(), "_eglRendererPlugin", physicsClientId=client)
-    pb.disconnect(client)
+    from ravh_sim.world.scene import connect, disconnect
+    disconnect(connect()[0])
 
 
 def bench_nav(houses: list[int] | None = None) -> dict[str, Any]:

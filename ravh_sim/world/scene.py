@@ -47,6 +47,29 @@ def cache_dir() -> Path:
     return path
 
 
+def connect(renderer: str = "auto") -> tuple[int, str]:
+    """A headless pybullet client with the EGL renderer loaded (unless ``renderer`` is 'tiny');
+    falls back to TinyRenderer with a one-line warning when EGL cannot start.
+    Returns (client, renderer actually used)."""
+    client = pb.connect(pb.DIRECT)
+    if renderer == "tiny":
+        return client, "tiny"
+    loader = pkgutil.get_loader("eglRenderer")
+    plugin = -1
+    if loader is not None:
+        with _quiet_stdout():
+            plugin = pb.loadPlugin(loader.get_filename(), "_eglRendererPlugin", physicsClientId=client)
+    if plugin < 0:
+        print("ravh_sim: EGL rendering unavailable, falling back to TinyRenderer (slower)", file=sys.stderr)
+        return client, "tiny"
+    return client, "egl"
+
+
+def disconnect(client: int) -> None:
+    with _quiet_stdout():
+        pb.disconnect(client)
+
+
 class World:
     """A house built in its own pybullet client (DIRECT: headless)."""
 
@@ -57,8 +80,7 @@ class World:
         self.house = house
         self.settings = settings
         self.physics_hz = physics_hz
-        self.client = pb.connect(pb.DIRECT)
-        self.renderer = self._load_renderer(renderer)
+        self.client, self.renderer = connect(renderer)
         pb.setGravity(0, 0, -9.81, physicsClientId=self.client)
         pb.setTimeStep(1.0 / physics_hz, physicsClientId=self.client)
         self._assets = cache_dir()
@@ -74,8 +96,7 @@ class World:
     # ------------------------------------------------------------------ life cycle
     def close(self) -> None:
         if self.client >= 0:
-            with _quiet_stdout():
-                pb.disconnect(self.client)
+            disconnect(self.client)
             self.client = -1
 
     def __enter__(self) -> World:
@@ -84,33 +105,17 @@ class World:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def _load_renderer(self, wanted: str) -> str:
-        if wanted == "tiny":
-            return "tiny"
-        loader = pkgutil.get_loader("eglRenderer")
-        plugin = -1
-        if loader is not None:
-            with _quiet_stdout():
-                plugin = pb.loadPlugin(loader.get_filename(), "_eglRendererPlugin",
-                                       physicsClientId=self.client)
-        if plugin < 0:
-            print("ravh_sim: EGL rendering unavailable, falling back to TinyRenderer (slower)",
-                  file=sys.stderr)
-            return "tiny"
-        return "egl"
-
     # ------------------------------------------------------------------ lookups
     def instance(self, name: str) -> Instance:
         return self._by_name[name]
 
     def body_to_instance_lut(self) -> np.ndarray:
         """Array mapping pybullet body id -> instance id (0 for bodies that are not instances)."""
-        lut = np.zeros(pb.getNumBodies(physicsClientId=self.client) + 64, dtype=np.int32)
+        c = self.client
+        top = max(pb.getBodyUniqueId(i, physicsClientId=c) for i in range(pb.getNumBodies(physicsClientId=c)))
+        lut = np.zeros(top + 1, dtype=np.int32)          # every body (robots too) has an entry
         for inst in self.instances:
-            if inst.body >= 0:
-                if inst.body >= len(lut):
-                    lut = np.pad(lut, (0, inst.body + 64 - len(lut)))
-                lut[inst.body] = inst.id
+            lut[inst.body] = inst.id
         return lut
 
     # ------------------------------------------------------------------ building
@@ -121,8 +126,7 @@ class World:
                                          physicsClientId=self.client)
         pb.createMultiBody(0, ground, -1, basePosition=[0, 0, self.floor_z - 0.051],
                            physicsClientId=self.client)
-        # Every texture is loaded before the first body: the EGL plugin ignores a texture loaded
-        # between creating a body and changing that body's visual shape.
+        # Every texture loads once, up front: run-time repaints then cost no file I/O.
         for name in ("palette", "white", *paints.TEXTURES):
             self._texture(name)
         self.instances = build_instances(self.house)
