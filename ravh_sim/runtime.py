@@ -22,7 +22,7 @@ from ravh_sim.nav.navigation import Navigation
 from ravh_sim.robot.profile import RobotProfile, load_profile
 from ravh_sim.robot.robot import Robot, compose, relative
 from ravh_sim.robot.simulation import Simulation
-from ravh_sim.sensors.camera import Capture, CameraOptions, SmartCamera
+from ravh_sim.sensors.camera import CameraOptions, Capture, SmartCamera
 from ravh_sim.sensors.laser import Laser, Scan
 from ravh_sim.sensors.mount import LINK_TO_OPTICAL, quaternion_from_matrix
 from ravh_sim.world.appearance import Appearance

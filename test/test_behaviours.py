@@ -5,14 +5,14 @@ import math
 
 import numpy as np
 import pytest
-
 from conftest import resolved
+
 from ravh_sim.behaviours.grid import GridSweep
 from ravh_sim.behaviours.teleop import Teleop
 from ravh_sim.behaviours.wanderer import Wanderer
-from ravh_sim.behaviours.waypoints import Layout, grid_nodes, light_waypoints, reachable_mask
+from ravh_sim.behaviours.waypoints import Layout, grid_nodes, light_waypoints
 from ravh_sim.nav.follower import PathFollower
-from ravh_sim.nav.grid import FREE
+from ravh_sim.nav.grid import FREE, reachable
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.robot.simulation import Simulation
 from ravh_sim.world.scene import World
@@ -52,7 +52,7 @@ def test_light_waypoints_lie_in_free_space_in_their_room(houses):
         grid = nav.map()
         start = house.station.position[:2]
         waypoints = light_waypoints(Layout.of(house), grid, start)
-        reach = reachable_mask(grid, start)
+        reach = reachable(grid, start)
         for room_id, points in waypoints.items():
             assert points
             for x, y in points:
@@ -85,7 +85,7 @@ def test_grid_nodes_cover_the_free_area_at_the_spacing(houses):
     on_lattice = np.all((cells - 5) % 10 == 0, axis=1)             # 0.5 m = 10 cells of 5 cm
     assert on_lattice.mean() > 0.6                                 # a lattice, plus fill-ins by walls
     assert len(set(map(tuple, cells))) == len(cells)
-    free = np.argwhere(reachable_mask(grid, start))
+    free = np.argwhere(reachable(grid, start))
     centres = np.array([grid.center_of(r, c) for r, c in free])
     nearest = np.min(np.linalg.norm(centres[:, None, :] - pts[None, :, :], axis=2), axis=1)
     assert nearest.max() <= 0.5 + 1e-6                              # every free cell near a node

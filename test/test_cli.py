@@ -7,8 +7,8 @@ import sys
 
 import cv2
 import pytest
-
 from conftest import subprocess_env
+
 from ravh_sim.cli import main
 
 

@@ -13,9 +13,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-
 from conftest import resolved
 from rosgraph import NodeProcess, spin_until, start_rclpy
+
 from ravh_msgs_py import names as n
 from ravh_sim.dataset import layout
 from ravh_sim.dataset.api import MIN_PIXELS, Dataset

@@ -4,11 +4,17 @@ from __future__ import annotations
 import json
 
 import pytest
-
 from conftest import resolved
+
 from ravh_sim.errors import FileFieldError
-from ravh_sim.world.footprint import (build_instances, dump_footprint, load_footprint, make_footprint,
-                                      mask_color, write_footprint)
+from ravh_sim.world.footprint import (
+    build_instances,
+    dump_footprint,
+    load_footprint,
+    make_footprint,
+    mask_color,
+    write_footprint,
+)
 from ravh_sim.world.ground_truth import GroundTruth
 from ravh_sim.world.settings import SUN_PRESETS, load_settings, resolve
 

@@ -3,11 +3,10 @@ from __future__ import annotations
 
 import json
 from collections import Counter
-from pathlib import Path
 
 import pytest
-
 from conftest import UPSTREAM
+
 from ravh_sim.errors import FileFieldError, UnknownNameError
 from ravh_sim.paths import HOUSES_DIR
 from ravh_sim.world.house import HOUSE_FORMAT, house_from_dict, load_house

@@ -32,19 +32,12 @@ def all_open(house) -> dict[str, bool]:
 
 
 def cell_centres(grid: Grid, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    rows, cols = np.nonzero(mask)
-    return (grid.origin[0] + (cols + 0.5) * grid.resolution,
-            grid.origin[1] + (rows + 0.5) * grid.resolution)
+    xs, ys = grid.cell_centres()
+    return xs[mask], ys[mask]
 
 
 def room_mask(grid: Grid, room) -> np.ndarray:
-    rows, cols = np.indices(grid.shape)
-    xs = grid.origin[0] + (cols + 0.5) * grid.resolution
-    ys = grid.origin[1] + (rows + 0.5) * grid.resolution
-    inside = np.zeros(grid.shape, bool)
-    for poly in (room.floor, *room.extra_floors):
-        inside |= points_in_polygon(xs, ys, poly)
-    return inside
+    return grid.polygons_mask((room.floor, *room.extra_floors))
 
 
 def roomiest_point(grid: Grid, room, within: np.ndarray | None = None) -> tuple[float, float] | None:

@@ -10,7 +10,6 @@ import json
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-
 from rosgraph import NodeProcess, spin_until, start_rclpy
 
 rclpy = pytest.importorskip("rclpy")

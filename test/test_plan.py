@@ -8,8 +8,20 @@ import numpy as np
 import pytest
 
 from ravh_sim.nav.grid import Grid
-from ravh_sim.viz.plan import (DOOR_CLOSED_RGB, FREE_ALPHA, FREE_RGB, MARGIN, MAX_SIDE, PATH_RGB,
-                               PLAN_PAD_M, ROOM_COLORS, draw_plan, render_plan, room_color, write_plan)
+from ravh_sim.viz.plan import (
+    DOOR_CLOSED_RGB,
+    FREE_ALPHA,
+    FREE_RGB,
+    MARGIN,
+    MAX_SIDE,
+    PATH_RGB,
+    PLAN_PAD_M,
+    ROOM_COLORS,
+    draw_plan,
+    render_plan,
+    room_color,
+    write_plan,
+)
 from ravh_sim.world.house import available_houses, load_house
 
 

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from rosgraph import ros_env
+
 from ravh_sim.dataset.api import Dataset
 from ravh_sim.dataset.raid import PRESETS, preset_settings, run_raid
 

@@ -7,7 +7,6 @@ import time
 
 import numpy as np
 import pytest
-
 from rosgraph import NodeProcess, spin_until, start_rclpy
 
 rclpy = pytest.importorskip("rclpy")

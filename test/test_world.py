@@ -5,8 +5,8 @@ import math
 
 import pybullet as pb
 import pytest
-
 from conftest import resolved
+
 from ravh_sim.world.footprint import build_instances
 from ravh_sim.world.scene import World
 

@@ -14,20 +14,12 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ravh_sim.nav.grid import FREE, Grid
-from ravh_sim.world.geometry import Polygon, points_in_polygon
+from ravh_sim.nav.grid import Grid, reachable
+from ravh_sim.world.geometry import Polygon
 from ravh_sim.world.house import House
 
 Point = tuple[float, float]
 ORDERS = ("cyclic", "once", "random")
-
-
-def reachable_mask(grid: Grid, start: Point) -> np.ndarray:
-    """FREE cells connected to the free cell nearest ``start``."""
-    free = (grid.data == FREE).astype(np.uint8)
-    _, labels = cv2.connectedComponents(free, connectivity=8)
-    r, c = nearest_free_cell(grid, start, free.astype(bool))
-    return labels == labels[r, c]
 
 
 def nearest_free_cell(grid: Grid, xy: Point, mask: np.ndarray) -> tuple[int, int]:
@@ -54,22 +46,13 @@ class Layout:
 
 def room_masks(layout: Layout, grid: Grid) -> dict[str, np.ndarray]:
     """Per room, the grid cells whose centres lie on its floor."""
-    rows, cols = np.mgrid[0:grid.shape[0], 0:grid.shape[1]]
-    xs = grid.origin[0] + (cols + 0.5) * grid.resolution
-    ys = grid.origin[1] + (rows + 0.5) * grid.resolution
-    out = {}
-    for room_id, polygons in layout.rooms.items():
-        mask = np.zeros(grid.shape, bool)
-        for poly in polygons:
-            mask |= points_in_polygon(xs, ys, poly)
-        out[room_id] = mask
-    return out
+    return {room_id: grid.polygons_mask(polygons) for room_id, polygons in layout.rooms.items()}
 
 
 def light_waypoints(layout: Layout, grid: Grid, start: Point) -> dict[str, list[Point]]:
     """Per room (house order), waypoints under its ceiling lights snapped into reachable free space;
     a room without a reachable light gets its most open reachable point. Unreachable rooms are left out."""
-    reach = reachable_mask(grid, start)
+    reach = reachable(grid, start)
     clearance = cv2.distanceTransform(reach.astype(np.uint8), cv2.DIST_L2, 5)
     out: dict[str, list[Point]] = {}
     for room_id, mask in room_masks(layout, grid).items():
@@ -102,7 +85,7 @@ def grid_nodes(layout: Layout, grid: Grid, start: Point, spacing: float = 0.5) -
     """Lattice nodes every ``spacing`` m on reachable free cells, room by room (nearest room next),
     each room toured nearest node first. Free strips the lattice misses (a narrow corridor between
     lattice rows) get extra nodes until every reachable cell is within ``spacing`` of a node of its room."""
-    reach = reachable_mask(grid, start)
+    reach = reachable(grid, start)
     step = max(1, int(round(spacing / grid.resolution)))
     lattice = np.zeros(grid.shape, bool)
     lattice[step // 2::step, step // 2::step] = True

@@ -8,7 +8,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
+
+from ravh_sim.world.geometry import points_in_polygon
 
 FREE, OCCUPIED, UNKNOWN = 0, 100, -1
 
@@ -38,3 +41,33 @@ class Grid:
     def is_free(self, x: float, y: float) -> bool:
         r, c = self.cell_of(x, y)
         return self.inside(r, c) and self.data[r, c] == FREE
+
+    def cell_centres(self) -> tuple[np.ndarray, np.ndarray]:
+        """(xs, ys): the house-frame centre of every cell, each of the grid's shape."""
+        rows, cols = np.indices(self.data.shape)
+        return (self.origin[0] + (cols + 0.5) * self.resolution,
+                self.origin[1] + (rows + 0.5) * self.resolution)
+
+    def polygons_mask(self, polygons) -> np.ndarray:
+        """Cells whose centres lie inside any of ``polygons`` (a room's floor outlines)."""
+        xs, ys = self.cell_centres()
+        inside = np.zeros(self.data.shape, bool)
+        for poly in polygons:
+            inside |= points_in_polygon(xs, ys, poly)
+        return inside
+
+
+def reachable(grid: Grid, start: tuple[float, float], snap: float = np.inf) -> np.ndarray:
+    """FREE cells connected to the free cell nearest ``start`` (within ``snap`` metres; all False if
+    none). 4-connected, as the planner moves: its diagonal steps need both orthogonal cells free."""
+    free = (grid.data == FREE).astype(np.uint8)
+    rows, cols = np.nonzero(free)
+    r, c = grid.cell_of(*start)
+    if rows.size == 0:
+        return np.zeros(grid.shape, bool)
+    d2 = (rows - r) ** 2 + (cols - c) ** 2
+    k = int(np.argmin(d2))
+    if np.sqrt(d2[k]) * grid.resolution > snap + grid.resolution:
+        return np.zeros(grid.shape, bool)
+    _, labels = cv2.connectedComponents(free, connectivity=4)
+    return labels == labels[rows[k], cols[k]]

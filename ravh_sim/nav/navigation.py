@@ -9,14 +9,12 @@ from __future__ import annotations
 
 from pathlib import Path as FilePath
 
-import cv2
 import numpy as np
 
 from ravh_sim.nav.freespace import distance_to_obstacle, free_space
-from ravh_sim.nav.grid import FREE, Grid
+from ravh_sim.nav.grid import FREE, Grid, reachable
 from ravh_sim.nav.mapio import write_map
 from ravh_sim.nav.planner import Path, Point, Unreachable, plan_path
-from ravh_sim.world.geometry import points_in_polygon
 from ravh_sim.robot.profile import RobotProfile
 from ravh_sim.world.house import House
 from ravh_sim.world.settings import Resolved
@@ -57,15 +55,9 @@ class Navigation:
         :class:`~ravh_sim.nav.planner.Unreachable` when the room has no such point."""
         room = self.house.room(room_id)
         grid = self.map()
-        rows, cols = np.indices(grid.shape)
-        xs = grid.origin[0] + (cols + 0.5) * grid.resolution
-        ys = grid.origin[1] + (rows + 0.5) * grid.resolution
-        usable = np.zeros(grid.shape, bool)
-        for poly in (room.floor, *room.extra_floors):
-            usable |= points_in_polygon(xs, ys, poly)
-        usable &= grid.data == FREE
+        usable = grid.polygons_mask((room.floor, *room.extra_floors)) & (grid.data == FREE)
         if start is not None:
-            usable &= _component_of(grid, start)
+            usable &= reachable(grid, start, START_SNAP)
         score = np.where(usable, distance_to_obstacle(grid), -1.0)
         r, c = np.unravel_index(int(np.argmax(score)), score.shape)
         if score[r, c] <= 0:
@@ -76,18 +68,3 @@ class Navigation:
     def write_map(self, directory: str | FilePath) -> tuple[FilePath, FilePath]:
         """``map.pgm`` and ``map.yaml`` (ROS map_server format) of the current map."""
         return write_map(self.map(), directory)
-
-
-def _component_of(grid: Grid, start: Point) -> np.ndarray:
-    """Mask of the free cells connected (4-connected, as the planner moves) to the free cell
-    nearest ``start`` within START_SNAP; all False if there is none."""
-    free = (grid.data == FREE).astype(np.uint8)
-    _, labels = cv2.connectedComponents(free, connectivity=4)
-    r, c = grid.cell_of(*start)
-    k = int(START_SNAP / grid.resolution) + 1
-    r0, c0 = max(r - k, 0), max(c - k, 0)
-    rr, cc = np.nonzero(free[r0:max(r + k + 1, 0), c0:max(c + k + 1, 0)])
-    if rr.size == 0:
-        return np.zeros(grid.shape, bool)
-    nearest = int(np.argmin(np.hypot(rr + r0 - r, cc + c0 - c)))
-    return labels == labels[rr[nearest] + r0, cc[nearest] + c0]

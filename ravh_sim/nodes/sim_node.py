@@ -28,8 +28,7 @@ from std_srvs.srv import Trigger
 from ravh_msgs_py import names as n
 from ravh_sim.errors import UserError
 from ravh_sim.nodes import convert
-from ravh_sim.nodes.common import (COMMAND_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, quiet_after_shutdown,
-                                   run_node)
+from ravh_sim.nodes.common import COMMAND_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, quiet_after_shutdown, run_node
 from ravh_sim.runtime import Agent, Rates, SimRuntime
 from ravh_sim.sensors.camera import CameraOptions
 from ravh_sim.sensors.imaging import encode_jpeg

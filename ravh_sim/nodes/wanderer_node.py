@@ -3,8 +3,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from ravh_sim.behaviours.waypoints import ORDERS, light_waypoints
 from ravh_sim.behaviours.wanderer import Wanderer
+from ravh_sim.behaviours.waypoints import ORDERS, light_waypoints
 from ravh_sim.nodes.behaviour_node import BehaviourNode, common_args
 from ravh_sim.nodes.common import run_node
 

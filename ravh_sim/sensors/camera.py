@@ -26,8 +26,14 @@ from ravh_sim.robot.profile import CameraSpec
 from ravh_sim.sensors import imaging
 from ravh_sim.sensors.egl import disable_shadow_map
 from ravh_sim.sensors.lighting import SUN_AMBIENT, SUN_DIFFUSE, Lighting
-from ravh_sim.sensors.mount import (CAMERA_OPTICAL_FRAME, LINK_TO_OPTICAL, floor_at, mount_position,
-                                    mount_rotation, quaternion_from_matrix)
+from ravh_sim.sensors.mount import (
+    CAMERA_OPTICAL_FRAME,
+    LINK_TO_OPTICAL,
+    floor_at,
+    mount_position,
+    mount_rotation,
+    quaternion_from_matrix,
+)
 from ravh_sim.world.appearance import sun_light
 from ravh_sim.world.scene import World
 
