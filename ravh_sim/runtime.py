@@ -66,7 +66,7 @@ class SimRuntime:
 
     def __init__(self, house: int | House, config: str | Path | None = None, seed: int | None = None,
                  renderer: str = "auto", rates: Rates | None = None,
-                 camera_options: CameraOptions | None = None, footprint: str | Path | None = None) -> None:
+                 footprint: str | Path | None = None) -> None:
         """``footprint``: rebuild exactly the world a footprint file describes (its house and its
         resolved settings); ``house``, ``config`` and ``seed`` are then ignored."""
         self.config_source = str(config or "config/default.yaml")
@@ -87,7 +87,8 @@ class SimRuntime:
             profile = load_profile(spec.profile)
             robot = self.sim.robot(spec.name)
             self.agents.append(Agent(spec.name, robot, profile,
-                                     SmartCamera(self.world, profile.camera, camera_options or CameraOptions()),
+                                     SmartCamera(self.world, profile.camera,
+                                                 CameraOptions(**dict(profile.camera_effects))),
                                      Laser(self.world, profile.laser), i == 0))
         self.navigation = Navigation(self.house, self.world.settings, self.agents[0].profile
                                      if self.agents else load_profile("giraff"))

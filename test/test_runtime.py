@@ -148,3 +148,22 @@ def test_a_footprint_rebuilds_the_same_world(runtime, tmp_path):
     finally:
         again.close()
         runtime.reset()
+
+
+def test_profile_camera_effects_are_validated(tmp_path):
+    import yaml
+
+    from ravh_sim.errors import FileFieldError
+    from ravh_sim.paths import ROBOTS_DIR
+    from ravh_sim.robot.profile import load_profile
+    data = yaml.safe_load((ROBOTS_DIR / "giraff.yaml").read_text())
+    data["camera"]["effects"] = {"pixel_noise": 3.0, "distortion": [-0.1, 0.01, 0.0, 0.0, 0.0]}
+    good = tmp_path / "noisy.yaml"
+    good.write_text(yaml.safe_dump(data))
+    effects = dict(load_profile(good).camera_effects)
+    assert effects["pixel_noise"] == 3.0 and effects["distortion"] == (-0.1, 0.01, 0.0, 0.0, 0.0)
+    data["camera"]["effects"] = {"sparkle": 1}
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(data))
+    with pytest.raises(FileFieldError, match="camera.effects.sparkle"):
+        load_profile(bad)

@@ -30,8 +30,6 @@ from ravh_sim.errors import UserError
 from ravh_sim.nodes import convert
 from ravh_sim.nodes.common import COMMAND_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, quiet_after_shutdown, run_node
 from ravh_sim.runtime import Agent, Rates, SimRuntime
-from ravh_sim.sensors.camera import CameraOptions
-from ravh_sim.sensors.imaging import encode_jpeg
 
 try:                                    # every full ROS install has tf2_msgs; the PyPI wheels do not
     from tf2_msgs.msg import TFMessage
@@ -46,7 +44,7 @@ WARN_THROTTLE_S = 2.0
 PARAMETERS: dict[str, Any] = {
     "house": 15, "seed": -1, "config": "", "footprint": "", "renderer": "auto", "real_time_factor": 1.0,
     "camera_rate": 10.0, "scan_rate": 10.0, "odom_rate": 50.0, "clock_rate": 100.0,
-    "cmd_vel_stamped": False, "jpeg_quality": 90,
+    "cmd_vel_stamped": False,
 }
 
 
@@ -58,11 +56,10 @@ class SimNode(Node):
         self.rtf = float(p["real_time_factor"])
         if not math.isfinite(self.rtf) or self.rtf < 0:
             raise UserError(f"real_time_factor must be >= 0 (0 = as fast as possible), got {self.rtf}")
-        self.jpeg_quality = int(p["jpeg_quality"])
         self.runtime = SimRuntime(int(p["house"]), p["config"] or None, None if p["seed"] < 0 else int(p["seed"]),
                                   renderer=p["renderer"],
                                   rates=Rates(p["camera_rate"], p["scan_rate"], p["odom_rate"], p["clock_rate"]),
-                                  camera_options=CameraOptions(), footprint=p["footprint"] or None)
+                                  footprint=p["footprint"] or None)
         rt = self.runtime
         self.get_logger().info(
             f"house {rt.house.number}: {len(rt.house.rooms)} rooms, {len(rt.house.objects)} objects, "
@@ -243,7 +240,7 @@ class SimNode(Node):
         info = convert.camera_info(cap.K, w, h, hdr, cap.camera_info.D)
         pubs["rgb"].publish(convert.image(cap.rgb, "rgb8", hdr))
         pubs["rgb_info"].publish(info)
-        pubs["jpeg"].publish(convert.compressed(encode_jpeg(cap.rgb, self.jpeg_quality), hdr))
+        pubs["jpeg"].publish(convert.compressed(agent.camera.encode_jpeg(cap.rgb), hdr))
         pubs["depth"].publish(convert.image(cap.depth, "32FC1", hdr))
         pubs["depth_info"].publish(info)
         pubs["instance"].publish(convert.image(cap.instance.astype("uint16"), "16UC1", hdr))

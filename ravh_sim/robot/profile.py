@@ -81,6 +81,7 @@ class RobotProfile:
     odom_angular_sigma: float        # rad per radian turned
     laser: LaserSpec
     camera: CameraSpec
+    camera_effects: tuple[tuple[str, Any], ...] = ()   # CameraOptions fields set by the profile
 
 
 def available_profiles() -> list[str]:
@@ -113,7 +114,24 @@ def load_profile(name_or_path: str | Path = "giraff") -> RobotProfile:
         camera=CameraSpec(cam.pos("height"), cam.num("pitch"), cam.num("forward"), int(cam.pos("width")),
                           int(cam.pos("height_px")), cam.pos("sensor_width"), cam.pos("sensor_height"),
                           cam.pos("focal_length"), cam.pos("near"), cam.pos("far"), cam.pos("rate")),
+        camera_effects=_effects(data.get("camera", {}).get("effects") or {}, str(path)),
     )
+
+
+def _effects(effects: Any, source: str) -> tuple[tuple[str, Any], ...]:
+    """The camera's realism effects, checked against CameraOptions so a typo names file and key."""
+    from ravh_sim.sensors.camera import CameraOptions
+    if not isinstance(effects, dict):
+        raise FileFieldError(source, "camera.effects", "expected a mapping of effect: value")
+    valid = set(CameraOptions.__dataclass_fields__)
+    for key in effects:
+        if key not in valid:
+            raise FileFieldError(source, f"camera.effects.{key}", f"unknown effect; valid: {', '.join(sorted(valid))}")
+    try:
+        CameraOptions(**effects)
+    except (TypeError, ValueError) as e:
+        raise FileFieldError(source, "camera.effects", str(e)) from None
+    return tuple(sorted((k, tuple(v) if isinstance(v, list) else v) for k, v in effects.items()))
 
 
 class _Reader:
