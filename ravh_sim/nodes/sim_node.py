@@ -30,6 +30,7 @@ from ravh_sim.errors import UserError
 from ravh_sim.nodes import convert
 from ravh_sim.nodes.common import COMMAND_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, quiet_after_shutdown, run_node
 from ravh_sim.runtime import Agent, Rates, SimRuntime
+from ravh_sim.sensors.imaging import encode_jpeg
 
 try:                                    # every full ROS install has tf2_msgs; the PyPI wheels do not
     from tf2_msgs.msg import TFMessage
@@ -240,7 +241,7 @@ class SimNode(Node):
         info = convert.camera_info(cap.K, w, h, hdr, cap.camera_info.D)
         pubs["rgb"].publish(convert.image(cap.rgb, "rgb8", hdr))
         pubs["rgb_info"].publish(info)
-        pubs["jpeg"].publish(convert.compressed(agent.camera.encode_jpeg(cap.rgb), hdr))
+        pubs["jpeg"].publish(convert.compressed(encode_jpeg(cap.rgb, agent.camera.options.jpeg_quality), hdr))
         pubs["depth"].publish(convert.image(cap.depth, "32FC1", hdr))
         pubs["depth_info"].publish(info)
         pubs["instance"].publish(convert.image(cap.instance.astype("uint16"), "16UC1", hdr))
