@@ -14,7 +14,7 @@ import cv2
 import numpy as np
 import pytest
 from conftest import resolved
-from rosgraph import NodeProcess, spin_until, start_rclpy
+from rosgraph import NodeProcess, remove_orphan_shm, spin_until, start_rclpy
 
 from ravh_msgs_py import names as n
 from ravh_sim.dataset import layout
@@ -294,6 +294,7 @@ def test_stamps_from_cdr_and_events_agree():
 def sim():
     recorder_module()
     import rclpy
+    started = time.time()
     proc = NodeProcess("sim", "--house", "20", "--seed", "0", "--camera-rate", "0", "--rtf", "0")
     start_rclpy()
     node = rclpy.create_node(f"dataset_probe_{os.getpid()}")
@@ -303,6 +304,7 @@ def sim():
     yield proc, node, client
     node.destroy_node()
     proc.stop()
+    remove_orphan_shm(started)            # the SIGKILLed recorder's segments, now that no one maps them
 
 
 def start_recorder(sim, out: Path, *args: str) -> NodeProcess:
