@@ -92,6 +92,7 @@ class SimRuntime:
                                      Laser(self.world, profile.laser), i == 0))
         self.navigation = Navigation(self.house, self.world.settings, self.agents[0].profile
                                      if self.agents else load_profile("giraff"))
+        self.ground_truth = GroundTruth(self.house, self.world.settings)   # reads the live settings
         self.map_version = 0
         self._map_state = self._door_model_state()
 
@@ -145,12 +146,6 @@ class SimRuntime:
         return None if room is None else room.id
 
     # ------------------------------------------------------------------ commands
-    def agent(self, name: str) -> Agent:
-        for a in self.agents:
-            if a.name == name:
-                return a
-        raise UserError(f"unknown agent {name!r}; valid: {', '.join(a.name for a in self.agents)}")
-
     def command(self, agent: Agent, v: float, w: float) -> None:
         """Velocity command; non-finite or absurd values raise UserError (the node warns)."""
         if not (math.isfinite(v) and math.isfinite(w)):
@@ -170,11 +165,8 @@ class SimRuntime:
         self._check_map()
 
     # ------------------------------------------------------------------ JSON services
-    def ground_truth(self) -> GroundTruth:
-        return GroundTruth(self.house, self.world.settings)
-
     def query(self, text: str) -> dict[str, Any]:
-        return self.ground_truth().answer(text)
+        return self.ground_truth.answer(text)
 
     def change_appearance(self, text: str | dict) -> dict[str, Any]:
         """Apply an appearance request (ravh_msgs_py.appearance); never raises."""
