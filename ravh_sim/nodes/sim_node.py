@@ -171,8 +171,7 @@ class SimNode(Node):
     # ------------------------------------------------------------------ publishing
     def _publish_latched(self) -> None:
         rt = self.runtime
-        footprint = rt.footprint()
-        self.footprint_pub.publish(String(data=json.dumps(footprint)))
+        footprint = self._publish_footprint()
         labels = {str(row["id"]): {"name": row["name"], "kind": row["kind"], "type": row["type"],
                                    "tags": row["tags"], "room": row["room"], "mask_color": row["mask_color"]}
                   for row in footprint["instances"]}
@@ -186,7 +185,12 @@ class SimNode(Node):
         self._published_map = rt.map_version
         self.map_pub.publish(convert.occupancy_grid(rt.navigation.map(), convert.header(rt.time, n.MAP_FRAME),
                                                     rt.time))
-        self.footprint_pub.publish(String(data=json.dumps(rt.footprint())))
+
+    def _publish_footprint(self) -> dict[str, Any]:
+        """The latched footprint: republished after every appearance change so it stays true."""
+        footprint = self.runtime.footprint()
+        self.footprint_pub.publish(String(data=json.dumps(footprint)))
+        return footprint
 
     def _frame(self, agent: Agent, frame: str) -> str:
         return n.agent_name(frame, agent.name, agent.first)
@@ -276,8 +280,7 @@ class SimNode(Node):
         reply = self.runtime.change_appearance(request.load_namespace)
         response.success, response.message = bool(reply["ok"]), json.dumps(reply)
         if reply["ok"]:
-            self._publish_map() if self.runtime.map_version != self._published_map else \
-                self.footprint_pub.publish(String(data=json.dumps(self.runtime.footprint())))
+            self._publish_footprint()            # /map follows on the next step if doors changed
         return response
 
     def _on_get_map(self, request: GetMap.Request, response: GetMap.Response):
@@ -308,6 +311,7 @@ class SimNode(Node):
     def _on_reset(self, request: Trigger.Request, response: Trigger.Response):
         try:
             self.runtime.reset()
+            self._publish_footprint()
             response.success, response.message = True, "agents back at their start poses"
         except Exception as e:  # never die from a request
             response.success, response.message = False, f"{type(e).__name__}: {e}"
