@@ -5,7 +5,6 @@ import math
 import time
 
 import pytest
-
 from rosgraph import NodeProcess, spin_until, start_rclpy
 
 rclpy = pytest.importorskip("rclpy")

@@ -475,3 +475,23 @@ def test_read_map_reports_bad_files(tmp_path):
                    "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
     with pytest.raises(UserError, match="missing.pgm: -: cannot read"):
         read_map(bad)
+
+
+def test_unreachable_names_only_the_doors_that_cut_the_way(houses):
+    from ravh_sim.nav.navigation import Navigation
+    from ravh_sim.robot.profile import load_profile
+    from ravh_sim.world.settings import load_settings, resolve
+    house = houses[20]
+    settings = resolve(load_settings(), house, 0)
+    settings.doors.update(Door_1=False, Door_2=False)           # Door_2 is the bathroom's, not on the way
+    nav = Navigation(house, settings, load_profile("giraff"))
+    goal = nav.room_goal("Bedroom_1")
+    with pytest.raises(Unreachable) as err:
+        nav.plan(house.station.position[:2], goal)
+    assert "closed doors: Door_1)" in str(err.value)
+    house23 = houses[23]
+    nav23 = Navigation(house23, resolve(load_settings(), house23, 0), load_profile("giraff"))
+    grid = nav23.map()
+    r, c = np.argwhere(grid.polygons_mask((house23.room("UtilityRoom_1").floor,)) & (grid.data == FREE))[0]
+    with pytest.raises(Unreachable, match=r"blocked \(walls or furniture\)"):
+        nav23.plan(house23.station.position[:2], grid.center_of(r, c))

@@ -7,6 +7,7 @@ rebuilt only when a door or a model differs from what it was built from.
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path as FilePath
 
 import numpy as np
@@ -14,7 +15,7 @@ import numpy as np
 from ravh_sim.nav.freespace import distance_to_obstacle, free_space
 from ravh_sim.nav.grid import FREE, Grid, reachable
 from ravh_sim.nav.mapio import write_map
-from ravh_sim.nav.planner import Path, Point, Unreachable, plan_path
+from ravh_sim.nav.planner import Path, Point, Unreachable, densify, plan_path
 from ravh_sim.robot.profile import RobotProfile
 from ravh_sim.world.house import House
 from ravh_sim.world.settings import Resolved
@@ -47,7 +48,33 @@ class Navigation:
     def plan(self, start: Point, goal: Point) -> Path:
         """A path on the current map; raises :class:`~ravh_sim.nav.planner.Unreachable` naming the
         rooms and the closed doors when there is none."""
-        return plan_path(self.map(), start, goal, house=self.house, blocked_by=self.closed_doors())
+        closed = self.closed_doors()
+        try:
+            return plan_path(self.map(), start, goal, house=self.house, blocked_by=closed)
+        except Unreachable as e:
+            if e.end != "goal" or not closed:
+                raise
+            raise self._why_unreachable(start, goal, closed) from None
+
+    def _why_unreachable(self, start: Point, goal: Point, closed: list[str]) -> Unreachable:
+        """Name the closed doors that really cut the way: those on the path that would exist with every
+        door open; if none would exist, walls or furniture are to blame, not the doors."""
+        open_all = free_space(self.house, {d: True for d in self.settings.doors}, self.settings.models,
+                              radius=self.profile.radius, height=self.profile.height, resolution=self.resolution)
+        try:
+            path = plan_path(open_all, start, goal)
+        except Unreachable:
+            blocking: list[str] = []
+        else:
+            points = densify(path.points, self.resolution)
+            blocking = [d for d in closed if any(
+                math.dist(p, self.house.door_by_id[d].position[:2]) < self.house.door_by_id[d].width / 2
+                for p in points)]
+        try:
+            plan_path(self.map(), start, goal, house=self.house, blocked_by=blocking)
+        except Unreachable as e:
+            return e
+        raise AssertionError("unreachable goal became reachable")
 
     def room_goal(self, room_id: str, start: Point | None = None) -> Point:
         """The free point of a room farthest from obstacles (where to send a robot told "go to the
