@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Set up .venv (tools/setup.sh) and run the main job: the sim node on a house (default 15), headless,
-# with a behaviour driving the robot (default: the wanderer, logging every capture). Ctrl-C stops
+# with a behaviour driving the robot (default: the wanderer, logging every capture to out/). Ctrl-C stops
 # both cleanly (SIGINT, so Fast DDS removes its shared-memory files).
 # Usage: bash tools/run.sh [--house N] [--seed S] [--behaviour wanderer|grid|none] [--rtf F]
 set -euo pipefail
@@ -23,7 +23,8 @@ stop() { for p in "${pids[@]}"; do kill -INT "$p" 2>/dev/null || true; done; wai
 trap stop INT TERM
 "$RAVH" sim --house "$house" --seed "$seed" --rtf "$rtf" & pids+=($!)
 if [ "$behaviour" != none ]; then
-  "$RAVH" "$behaviour" --log "captures_house${house}.jsonl" & pids+=($!)
+  mkdir -p out
+  "$RAVH" "$behaviour" --log "out/captures_house${house}.jsonl" & pids+=($!)
 fi
 echo "ravh_sim: house $house running (behaviour: $behaviour); Ctrl-C to stop" >&2
 wait -n "${pids[@]}"
