@@ -23,6 +23,7 @@ from ravh_sim.dataset.summary import render_summary, write_summary
 from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid
+from ravh_sim.sensors import imaging
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.house import load_house
 
@@ -171,9 +172,9 @@ def test_torn_lines_and_missing_files_are_skipped(tmp_path, footprint20):
 
 def test_depth_encoding_limits():
     metres = np.array([[0.0005, 0.0004, 1.23456, 65.535, 65.6, np.nan, -np.inf]])
-    mm = layout.depth_to_png(metres)
+    mm = imaging.depth_to_png(metres)
     assert mm.dtype == np.uint16 and mm.tolist() == [[0, 0, 1235, 65535, 0, 0, 0]]
-    back = layout.depth_from_png(mm)
+    back = imaging.depth_from_png(mm)
     assert back[0, 2] == pytest.approx(1.235) and np.isnan(back[0, 4:]).all()
 
 

@@ -20,6 +20,7 @@ from ravh_sim.dataset import layout
 from ravh_sim.errors import FileFieldError, UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.mapio import read_map
+from ravh_sim.sensors import imaging
 from ravh_sim.world.house import House, load_house
 from ravh_sim.world.settings import Resolved
 
@@ -60,7 +61,7 @@ class Sample:
     @cached_property
     def depth(self) -> np.ndarray:
         """(H, W) float32 metres along the optical axis, NaN = no depth (1 mm steps)."""
-        return layout.depth_from_png(layout.read_png(self.files["depth"]))
+        return imaging.depth_from_png(layout.read_png(self.files["depth"]))
 
     @cached_property
     def instance(self) -> np.ndarray:

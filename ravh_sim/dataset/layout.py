@@ -32,8 +32,6 @@ CAPTURE_FILES: dict[str, tuple[str, str]] = {
     "mask": ("mask", ".png"),          # 16-bit instance ids, 0 = nothing
     "scan": ("scan", ".npy"),          # float32 (N, 2): angle (rad), range (m; inf/nan as published)
 }
-DEPTH_SCALE = 1000.0                   # depth PNG units per metre
-DEPTH_MAX_M = 65.535                   # deepest representable depth; farther is stored as 0
 
 
 def capture_files(index: int) -> dict[str, str]:
@@ -71,20 +69,6 @@ def read_png(path: Path) -> np.ndarray:
     if image is None:
         raise OSError(f"{path}: cannot read the PNG")
     return cv2.cvtColor(image, cv2.COLOR_BGR2RGB) if image.ndim == 3 else image
-
-
-def depth_to_png(metres: np.ndarray) -> np.ndarray:
-    """Float metres (NaN/inf/<=0 invalid) -> uint16 millimetres, 0 = invalid (±0.5 mm rounding)."""
-    mm = np.round(np.asarray(metres, np.float64) * DEPTH_SCALE)
-    valid = np.isfinite(mm) & (mm > 0) & (mm <= DEPTH_MAX_M * DEPTH_SCALE)
-    return np.where(valid, mm, 0).astype(np.uint16)
-
-
-def depth_from_png(mm: np.ndarray) -> np.ndarray:
-    """uint16 millimetres -> float32 metres, NaN where 0 (the REP 118 convention of the topic)."""
-    metres = mm.astype(np.float32) / np.float32(DEPTH_SCALE)
-    metres[mm == 0] = np.nan
-    return metres
 
 
 def encode_scan(ranges: np.ndarray, angle_min: float, angle_increment: float) -> bytes:

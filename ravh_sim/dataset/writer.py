@@ -22,6 +22,7 @@ from ravh_sim.dataset import layout
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.mapio import write_map
+from ravh_sim.sensors import imaging
 from ravh_sim.world.footprint import dump_footprint
 
 Pose2D = Sequence[float]
@@ -95,7 +96,7 @@ class DatasetWriter:
         files = layout.capture_files(index)
         payload = {
             "rgb": layout.encode_png(np.ascontiguousarray(rgb, np.uint8)),
-            "depth": layout.encode_png(layout.depth_to_png(depth)),
+            "depth": layout.encode_png(imaging.depth_to_png(depth)),
             "mask": layout.encode_png(instance.astype(np.uint16)),
             "scan": layout.encode_scan(scan_ranges, scan_meta["angle_min"], scan_meta["angle_increment"]),
         }

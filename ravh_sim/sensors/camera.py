@@ -259,8 +259,7 @@ def write_capture(camera: SmartCamera, capture: Capture, directory: Path) -> lis
     directory.mkdir(parents=True, exist_ok=True)
     paths = [directory / name for name in ("rgb.png", "depth.png", "mask.png", "info.json")]
     cv2.imwrite(str(paths[0]), cv2.cvtColor(capture.rgb, cv2.COLOR_RGB2BGR))
-    millimetres = np.nan_to_num(capture.depth * 1000.0, nan=0.0, posinf=0.0, neginf=0.0)
-    cv2.imwrite(str(paths[1]), np.clip(np.round(millimetres), 0, 65535).astype(np.uint16))
+    cv2.imwrite(str(paths[1]), imaging.depth_to_png(capture.depth))
     cv2.imwrite(str(paths[2]), cv2.cvtColor(camera.instance_color(capture), cv2.COLOR_RGB2BGR))
     counts = np.bincount(capture.instance.ravel())
     by_id = {inst.id: inst for inst in camera.world.instances}

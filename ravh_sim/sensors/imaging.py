@@ -12,6 +12,8 @@ import cv2
 import numpy as np
 
 MAX_BLUR_SAMPLES = 9
+DEPTH_SCALE = 1000.0                   # depth PNG units per metre (16-bit millimetres)
+DEPTH_MAX_M = 65.535                   # deepest representable depth; farther is stored as 0
 
 
 def encode_jpeg(rgb: np.ndarray, quality: int) -> bytes:
@@ -85,3 +87,17 @@ class LensDistortion:
         interpolation = cv2.INTER_NEAREST if nearest else cv2.INTER_LINEAR
         return cv2.remap(image, self.map_x, self.map_y, interpolation, borderMode=cv2.BORDER_CONSTANT,
                          borderValue=fill)
+
+
+def depth_to_png(metres: np.ndarray) -> np.ndarray:
+    """Float metres (NaN/inf/<=0 invalid) -> uint16 millimetres, 0 = invalid (±0.5 mm rounding)."""
+    mm = np.round(np.asarray(metres, np.float64) * DEPTH_SCALE)
+    valid = np.isfinite(mm) & (mm > 0) & (mm <= DEPTH_MAX_M * DEPTH_SCALE)
+    return np.where(valid, mm, 0).astype(np.uint16)
+
+
+def depth_from_png(mm: np.ndarray) -> np.ndarray:
+    """uint16 millimetres -> float32 metres, NaN where 0 (the REP 118 convention of the topic)."""
+    metres = mm.astype(np.float32) / np.float32(DEPTH_SCALE)
+    metres[mm == 0] = np.nan
+    return metres
