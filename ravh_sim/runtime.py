@@ -24,7 +24,7 @@ from ravh_sim.robot.robot import Robot, compose, relative
 from ravh_sim.robot.simulation import Simulation
 from ravh_sim.sensors.camera import CameraOptions, Capture, SmartCamera
 from ravh_sim.sensors.laser import Laser, Scan
-from ravh_sim.sensors.mount import LINK_TO_OPTICAL, quaternion_from_matrix
+from ravh_sim.sensors.mount import LINK_TO_OPTICAL, mount_position, mount_rotation, quaternion_from_matrix
 from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import load_footprint, make_footprint
 from ravh_sim.world.ground_truth import GroundTruth
@@ -131,13 +131,15 @@ class SimRuntime:
         return compose(agent.robot.pose, relative(agent.robot.odometry, (0.0, 0.0, 0.0)))
 
     def static_transforms(self, agent: Agent) -> list[tuple[str, str, tuple, tuple]]:
-        """(parent, child, xyz, quaternion xyzw) of the sensor mounts on base_link (at floor level)."""
+        """(parent, child, xyz, quaternion xyzw) of the sensor mounts on base_link (at floor level),
+        from the same mount functions the camera and laser render with, so TF and images agree."""
         cam, laser = agent.profile.camera, agent.profile.laser
-        pitch = math.radians(cam.pitch_deg)
+        camera_xyz = mount_position(0.0, 0.0, 0.0, 0.0, cam.height, cam.forward)
         return [
-            (names.BASE_FRAME, names.LASER_FRAME, (0.0, 0.0, laser.height), (0.0, 0.0, 0.0, 1.0)),
-            (names.BASE_FRAME, names.CAMERA_FRAME, (cam.forward, 0.0, cam.height),
-             (0.0, math.sin(pitch / 2), 0.0, math.cos(pitch / 2))),        # pitched down about +y
+            (names.BASE_FRAME, names.LASER_FRAME, tuple(mount_position(0.0, 0.0, 0.0, 0.0, laser.height)),
+             quaternion_from_matrix(mount_rotation(0.0))),
+            (names.BASE_FRAME, names.CAMERA_FRAME, tuple(camera_xyz),
+             quaternion_from_matrix(mount_rotation(0.0, math.radians(cam.pitch_deg)))),
             (names.CAMERA_FRAME, names.CAMERA_OPTICAL_FRAME, (0.0, 0.0, 0.0), OPTICAL_ROTATION),
         ]
 

@@ -19,6 +19,7 @@ from sensor_msgs.msg import CameraInfo, CompressedImage, Image, LaserScan
 from std_msgs.msg import Header
 
 from ravh_sim.nav.grid import Grid
+from ravh_sim.world.geometry import quaternion_from_yaw
 
 Pose2D = tuple[float, float, float]
 
@@ -92,7 +93,8 @@ def occupancy_grid(grid: Grid, hdr: Header, map_load_time: float) -> OccupancyGr
 
 
 def yaw_quaternion(yaw: float) -> Quaternion:
-    return Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))
+    x, y, z, w = quaternion_from_yaw(yaw)
+    return Quaternion(x=x, y=y, z=z, w=w)
 
 
 def pose_2d(p: Pose2D, z: float = 0.0) -> Pose:
@@ -115,7 +117,7 @@ def transform(parent_hdr: Header, child: str, xyz: Sequence[float], quat_xyzw: S
 
 
 def transform_2d(parent_hdr: Header, child: str, p: Pose2D) -> TransformStamped:
-    return transform(parent_hdr, child, (p[0], p[1], 0.0), (0.0, 0.0, math.sin(p[2] / 2), math.cos(p[2] / 2)))
+    return transform(parent_hdr, child, (p[0], p[1], 0.0), quaternion_from_yaw(p[2]))
 
 
 def odometry(p: Pose2D, v: float, w: float, hdr: Header, child: str,
