@@ -18,6 +18,7 @@ from ravh_sim.errors import UserError
 from ravh_sim.nodes.launch import NODES
 from ravh_sim.nodes.launch import main as launch_node
 from ravh_sim.paths import HOUSES_DIR
+from ravh_sim.render.backend import BACKENDS
 
 Command = Callable[[argparse.Namespace], int]
 
@@ -260,7 +261,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--sun", default=None, help="sun angle in degrees, or day, sunset, night (default: config)")
     p.add_argument("--lights", choices=("on", "off", "random"), default=None,
                    help="switch every light (default: config); random uses --seed")
-    p.add_argument("--renderer", choices=("auto", "egl", "tiny"), default="auto")
+    p.add_argument("--renderer", choices=BACKENDS, default="auto")
     p.add_argument("--profile", default="giraff", help="robot profile for the camera (default: giraff)")
     p.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     p.set_defaults(func=cmd_render)

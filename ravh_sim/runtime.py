@@ -266,4 +266,6 @@ class SimRuntime:
         return make_footprint(self.house, self.world.settings)
 
     def close(self) -> None:
+        for agent in self.agents:
+            agent.camera.close()
         self.world.close()

@@ -27,6 +27,7 @@ from std_srvs.srv import Trigger
 
 from ravh_msgs_py import names as n
 from ravh_sim.errors import UserError
+from ravh_sim.render.backend import BACKENDS
 from ravh_sim.nodes import convert
 from ravh_sim.nodes.common import COMMAND_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, quiet_after_shutdown, run_node
 from ravh_sim.runtime import Agent, Rates, SimRuntime
@@ -336,7 +337,7 @@ def parse_args(argv: list[str]) -> dict[str, Any]:
     p.add_argument("--seed", type=int)
     p.add_argument("--config")
     p.add_argument("--footprint", help="rebuild the world of this footprint file (house and settings)")
-    p.add_argument("--renderer", choices=("auto", "egl", "tiny"))
+    p.add_argument("--renderer", choices=BACKENDS)
     p.add_argument("--rtf", "--real-time-factor", dest="real_time_factor", type=float,
                    help="sim seconds per wall second; 0 = as fast as possible (default 1)")
     p.add_argument("--camera-rate", dest="camera_rate", type=float)

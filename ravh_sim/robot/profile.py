@@ -14,6 +14,7 @@ import yaml
 
 from ravh_sim.errors import FileFieldError, UnknownNameError
 from ravh_sim.paths import ROBOTS_DIR
+from ravh_sim.render.backend import QUALITIES
 
 
 @dataclass(frozen=True)
@@ -48,6 +49,7 @@ class CameraSpec:
     near: float              # m
     far: float               # m
     rate: float              # Hz
+    quality: str = "realistic"   # realistic | fast (ravh_sim.render.backend.QUALITIES)
 
     @property
     def fx(self) -> float:
@@ -113,7 +115,8 @@ def load_profile(name_or_path: str | Path = "giraff") -> RobotProfile:
                         lz.pos("range_max"), lz.pos("rate"), lz.nonneg("noise_sigma")),
         camera=CameraSpec(cam.pos("height"), cam.num("pitch"), cam.num("forward"), int(cam.pos("width")),
                           int(cam.pos("height_px")), cam.pos("sensor_width"), cam.pos("sensor_height"),
-                          cam.pos("focal_length"), cam.pos("near"), cam.pos("far"), cam.pos("rate")),
+                          cam.pos("focal_length"), cam.pos("near"), cam.pos("far"), cam.pos("rate"),
+                          cam.choice("quality", QUALITIES, "realistic")),
         camera_effects=_effects(data.get("camera", {}).get("effects") or {}, str(path)),
     )
 
@@ -156,6 +159,13 @@ class _Reader:
             raise FileFieldError(self.source, f"{self.prefix and self.prefix + '.'}{key}",
                                  f"must be > 0, got {value}")
         return value
+
+    def choice(self, key: str, options: tuple[str, ...], default: str) -> str:
+        value = self.data.get(key, default)
+        if value not in options:
+            raise FileFieldError(self.source, f"{self.prefix and self.prefix + '.'}{key}",
+                                 f"expected one of {', '.join(options)}, got {value!r}")
+        return str(value)
 
     def nonneg(self, key: str) -> float:
         value = self.num(key)

@@ -1,15 +1,13 @@
-"""The smart camera: RGB, depth and instance images from one pybullet render, pinhole-exact.
+"""The smart camera: RGB, depth and instance images from one render, pinhole-exact.
 
-One ``getCameraImage`` call gives colour, the depth buffer and the body segmentation. The OpenGL
-projection is built from K (fx, fy, cx, cy, near, far), so a 3D point projected with K lands on the
-pixel where it is drawn (OpenCV pixel convention: pixel i covers [i - 0.5, i + 0.5]). Depth is REP 118
-z-depth along the optical axis in metres (NaN where nothing is hit within ``far``); instance ids come
-from the World's body->instance table (0 = nothing). The lighting pass adds daylight colour, lamps and
-the sky; optional effects (motion blur, lens distortion, noise, JPEG) follow in that order, seeded
-from the world seed and a capture counter so the same seed and poses give identical images.
-
-Renderer: the EGL plugin (with its shadow-map pass switched off, see :mod:`egl`) or TinyRenderer
-when the World fell back to it; TinyRenderer gets the EGL shader's light coefficients so both agree.
+The renderer (ravh_sim.render: our physically based GL renderer, or pybullet's TinyRenderer where
+no GL context can be made) draws RGB, depth and instance ids from the same triangles with a
+projection built from K, so a 3D point projected with K lands on the pixel where it is drawn (OpenCV
+pixel convention: pixel i covers [i - 0.5, i + 0.5]). Depth is REP 118 z-depth along the optical
+axis in metres (NaN where nothing is hit within ``far``); instance ids are the World's (0 = nothing).
+On the TinyRenderer fallback a lighting pass (:mod:`lighting`) adds daylight colour, lamps and the
+sky. Optional effects (motion blur, lens distortion, noise, JPEG) follow in that order, seeded from
+the world seed, the agent and a capture counter so the same seed and poses give identical images.
 """
 from __future__ import annotations
 
@@ -22,9 +20,10 @@ import cv2
 import numpy as np
 import pybullet as pb
 
+from ravh_sim.render.gl_renderer import GLRenderer
+from ravh_sim.render.projection import SAMPLE_OFFSET, projection_from_K, view_matrix
 from ravh_sim.robot.profile import CameraSpec
 from ravh_sim.sensors import imaging
-from ravh_sim.sensors.egl import disable_shadow_map
 from ravh_sim.sensors.lighting import SUN_AMBIENT, SUN_DIFFUSE, Lighting
 from ravh_sim.sensors.mount import (
     CAMERA_OPTICAL_FRAME,
@@ -39,11 +38,6 @@ from ravh_sim.world.scene import World
 
 DISTORTION_MODEL = "plumb_bob"
 NOISE_STREAM = 1            # noise generator stream of cameras (lasers use another)
-# Where each renderer samples a pixel (see projection_from_K), measured against K: OpenGL samples
-# pixel centres; TinyRenderer samples pixel corners, and its flipped rows are one pixel off.
-SAMPLE_OFFSET = {"egl": (0.5, 0.5), "tiny": (0.0, 1.0)}
-# Optical frame -> OpenGL eye frame (x right, y up, z backwards).
-OPTICAL_TO_GL = np.diag([1.0, -1.0, -1.0])
 
 
 @dataclass(frozen=True)
@@ -73,8 +67,8 @@ class CameraInfo:
 
 @dataclass
 class Frame:
-    """One pybullet render, unlit: what the lighting pass and the effects start from."""
-    rgb: np.ndarray                        # (H, W, 3) uint8, albedo x pybullet's sun shading
+    """One render, before effects (on the TinyRenderer fallback also before its lighting pass)."""
+    rgb: np.ndarray                        # (H, W, 3) uint8
     depth: np.ndarray                      # (H, W) float32 z-depth, NaN = nothing
     instance: np.ndarray                   # (H, W) uint16
     background: np.ndarray                 # (H, W) bool, no body (sky)
@@ -109,15 +103,21 @@ class SmartCamera:
         self._gl_projection = self.projection.T.ravel().tolist()      # column-major for pybullet
         self._lens = (imaging.LensDistortion(self.K, self.options.distortion, self.width, self.height)
                       if self.options.distortion is not None else None)
-        self.lighting = Lighting(world, self.K, self.width, self.height)
+        self.gl = (GLRenderer(world, self.K, self.width, self.height, spec.near, spec.far, spec.quality)
+                   if world.renderer == "gl" else None)
+        self.lighting = Lighting(world, self.K, self.width, self.height) if self.gl is None else None
         self._instance_rgb = np.zeros((max(i.id for i in world.instances) + 1, 3), np.uint8)
         for inst in world.instances:
             self._instance_rgb[inst.id] = inst.mask_color
         if len(self._instance_rgb) > np.iinfo(np.uint16).max:
             raise ValueError("too many instances for 16-bit instance images")
-        if world.renderer == "egl":
-            disable_shadow_map()
         self.count = 0
+
+    def close(self) -> None:
+        """Free the camera's GPU objects (a World's cameras are closed with it)."""
+        if self.gl is not None:
+            self.gl.release()
+            self.gl = None
 
     # ------------------------------------------------------------------ geometry
     def optical_pose(self, x: float, y: float, yaw: float, floor_z: float | None = None
@@ -146,8 +146,11 @@ class SmartCamera:
 
     # ------------------------------------------------------------------ capture
     def render(self, x: float, y: float, yaw: float, floor_z: float | None = None) -> Frame:
-        """pybullet's render from robot pose (x, y, yaw), before lighting and effects."""
+        """The render from robot pose (x, y, yaw), before effects."""
         position, rotation = self.optical_pose(x, y, yaw, floor_z)
+        if self.gl is not None:
+            views = self.gl.render(position, rotation)
+            return Frame(views.rgb, views.depth, views.instance, views.background, position, rotation)
         rgb, depth, instance, background = self._render(position, rotation,
                                                          sun_light(self.world.settings.sun_angle).direction)
         return Frame(rgb, depth, instance, background, position, rotation)
@@ -159,16 +162,9 @@ class SmartCamera:
         settings = self.world.settings
         sun = sun_light(settings.sun_angle)
         frame = self.render(x, y, yaw, floor_z)
-        depth, instance, background = frame.depth, frame.instance, frame.background
-        panes = self.lighting.glass_panes(depth, instance, frame.rotation, frame.position)
-        lights = [lt for lt in self.world.house.lights if settings.lights.get(lt.id, False)]
-        rgb = self.lighting.apply(frame.rgb, depth, instance, frame.rotation, frame.position, sun, lights)
-        if panes is not None:
-            glass = panes > 0
-            instance[glass] = panes[glass]
-            background |= glass
-        if background.any():
-            rgb[background] = sun.sky
+        rgb, depth, instance = frame.rgb, frame.depth, frame.instance
+        if self.lighting is not None:
+            rgb = self._tiny_lighting(frame, sun)
         rng = np.random.default_rng([settings.seed, NOISE_STREAM, self.count])
         if opts.motion_blur and any(velocity):
             distance = float(np.nanmedian(depth)) if np.isfinite(depth).any() else self.spec.far
@@ -188,24 +184,30 @@ class SmartCamera:
         self.count += 1
         return capture
 
+    def _tiny_lighting(self, frame: Frame, sun) -> np.ndarray:
+        """The TinyRenderer fallback's lighting pass: daylight, lamps, sky in the background."""
+        assert self.lighting is not None
+        settings = self.world.settings
+        lights = [lt for lt in self.world.house.lights if settings.lights.get(lt.id, False)]
+        rgb = self.lighting.apply(frame.rgb, frame.depth, frame.instance, frame.rotation, frame.position,
+                                  sun, lights)
+        if frame.background.any():
+            rgb[frame.background] = sun.sky
+        return rgb
+
     def instance_color(self, capture: Capture) -> np.ndarray:
         """(H, W, 3) uint8 image of the instance ids in their footprint mask colours (black = nothing)."""
         return self._instance_rgb[capture.instance]
 
     def _render(self, position: np.ndarray, rotation: np.ndarray, light_direction
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """One pybullet render: (rgb uint8, z-depth float32, instance uint16, background mask)."""
+        """One TinyRenderer render: (rgb uint8, z-depth float32, instance uint16, background mask)."""
         view = view_matrix(position, rotation)
-        kwargs = {"lightDirection": list(light_direction)}
-        if self.world.renderer == "egl":
-            kwargs["renderer"] = pb.ER_BULLET_HARDWARE_OPENGL
-        else:
-            kwargs.update(renderer=pb.ER_TINY_RENDERER, shadow=0, lightColor=[1.0, 1.0, 1.0],
-                          lightAmbientCoeff=SUN_AMBIENT, lightDiffuseCoeff=SUN_DIFFUSE,
-                          lightSpecularCoeff=0.0)
-        _, _, rgba, buffer, seg = pb.getCameraImage(self.width, self.height, view.T.ravel().tolist(),
-                                                    self._gl_projection, physicsClientId=self.world.client,
-                                                    **kwargs)
+        _, _, rgba, buffer, seg = pb.getCameraImage(
+            self.width, self.height, view.T.ravel().tolist(), self._gl_projection,
+            physicsClientId=self.world.client, lightDirection=list(light_direction),
+            renderer=pb.ER_TINY_RENDERER, shadow=0, lightColor=[1.0, 1.0, 1.0],
+            lightAmbientCoeff=SUN_AMBIENT, lightDiffuseCoeff=SUN_DIFFUSE, lightSpecularCoeff=0.0)
         rgba = np.asarray(rgba, np.uint8).reshape(self.height, self.width, 4)
         buffer = np.asarray(buffer, np.float32).reshape(self.height, self.width)
         seg = np.asarray(seg, np.int32).reshape(self.height, self.width)
@@ -224,33 +226,6 @@ class SmartCamera:
         return CameraInfo(CAMERA_OPTICAL_FRAME, self.width, self.height, DISTORTION_MODEL,
                           tuple(float(v) for v in d), tuple(float(v) for v in k.ravel()),
                           tuple(float(v) for v in np.eye(3).ravel()), tuple(float(v) for v in p.ravel()))
-
-
-def projection_from_K(K: np.ndarray, width: int, height: int, near: float, far: float,
-                      sample_offset: tuple[float, float] = (0.5, 0.5)) -> np.ndarray:
-    """OpenGL projection (row-major 4x4) whose pixels match the pinhole model K exactly.
-
-    OpenCV's pixel (u, v) has its centre at (u, v). A renderer colours it with what it finds at
-    window x = u + ox and, rows being flipped, y = height - v - oy, with (ox, oy) = ``sample_offset``:
-    (0.5, 0.5) for OpenGL, which samples pixel centres. Solving NDC = f(K) for both axes gives the
-    principal-point terms.
-    """
-    fx, fy, cx, cy = K[0, 0], K[1, 1], K[0, 2], K[1, 2]
-    ox, oy = sample_offset
-    return np.array([
-        [2 * fx / width, 0.0, 1 - 2 * (cx + ox) / width, 0.0],
-        [0.0, 2 * fy / height, 2 * (cy + oy) / height - 1, 0.0],
-        [0.0, 0.0, -(far + near) / (far - near), -2 * far * near / (far - near)],
-        [0.0, 0.0, -1.0, 0.0]])
-
-
-def view_matrix(position: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    """OpenGL view matrix (row-major 4x4) of an optical frame (rotation columns = x right, y down, z fwd)."""
-    eye = rotation @ OPTICAL_TO_GL                 # eye-frame axes in the house frame
-    view = np.eye(4)
-    view[:3, :3] = eye.T
-    view[:3, 3] = -eye.T @ position
-    return view
 
 
 def write_capture(camera: SmartCamera, capture: Capture, directory: Path) -> list[Path]:

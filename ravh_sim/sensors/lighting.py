@@ -1,8 +1,8 @@
-"""The lighting pass: daylight colour, switched-on lamps and the sky over pybullet's one-light render.
+"""The TinyRenderer fallback's lighting pass: daylight colour, switched-on lamps and the sky over
+pybullet's one-light render (the GL renderer in ravh_sim.render lights its images itself).
 
-pybullet draws one directional light with fixed shading (EGL: ``albedo * (0.75 + 0.25 n.l)``; the
-EGL plugin ignores lightColor and the ambient/diffuse/specular coefficients, measured), so daylight
-colour and every other light are added here, for both renderers, per pixel, from what the render
+pybullet draws one directional light with fixed shading (``albedo * (0.75 + 0.25 n.l)``), so daylight
+colour and every other light are added here, per pixel, from what the render
 gives: depth (3D points and normals through K), instance ids (which room a pixel belongs to) and
 the rendered colour (albedo is the colour divided by pybullet's own shading). Each switched-on light
 adds ``albedo * colour * intensity * max(0, n.l) * falloff(d, range)`` to the pixels of its own room
@@ -10,14 +10,9 @@ only, so light never leaks through walls. The room of a pixel is the room of the
 there: exact on walls, which lie on room boundaries where a floor-plan lookup is ambiguous. Light is
 computed on a half-resolution grid and upsampled (it varies smoothly), which keeps the pass at a few
 milliseconds.
-
-The sky (daylight colour from :func:`sun_light`) fills the background and the windows' panes: house
-walls are not cut at windows and the window models' glass sits inside the wall, so the wall pixels
-inside a window's outline are shown as sky and labelled with the window's instance id.
 """
 from __future__ import annotations
 
-import math
 
 import cv2
 import numpy as np
@@ -26,8 +21,7 @@ from ravh_sim.world.appearance import SunLight
 from ravh_sim.world.house import Light
 from ravh_sim.world.scene import World
 
-# pybullet's EGL shading of the sun: ambient + diffuse * n.l, n.l in [-1, 1] (TinyRenderer is set to
-# the same coefficients, but clamps n.l at 0).
+# pybullet's shading of the sun: ambient + diffuse * n.l (TinyRenderer clamps n.l at 0).
 SUN_AMBIENT = 0.75
 SUN_DIFFUSE = 0.25
 LAMP_EXPOSURE = 2.2        # camera exposure for lamp light at night
@@ -39,7 +33,6 @@ NORMAL_BLUR = 5            # box filter (light-map samples) over normals
 FAR_FILL = 1e3             # m: stands in for "no depth" so no NaN reaches the light sums
 CREASE_COS = 0.7           # filtered normal over ~45 degrees off the raw one: keep the raw one
 SILHOUETTE_JUMP = 0.1      # a tangent whose depth step exceeds 0.1 * z per sample bridges two surfaces
-GLASS_MARGIN = 0.03        # m beyond a window's half thickness where the wall face still counts as pane
 STEP = 2                   # light map: one sample per STEP x STEP pixels
 
 
@@ -51,7 +44,6 @@ class Lighting:
         self.fx, self.fy, self.cx, self.cy = float(K[0, 0]), float(K[1, 1]), float(K[0, 2]), float(K[1, 2])
         self._rx = ((np.arange(width) - self.cx) / self.fx).astype(np.float32)
         self._ry = ((np.arange(height) - self.cy) / self.fy).astype(np.float32)
-        self._signed = world.renderer == "egl"
         house = world.house
         self._room_index = {room.id: i for i, room in enumerate(house.rooms)}
         size = max(inst.id for inst in world.instances) + 1
@@ -61,8 +53,6 @@ class Lighting:
             self._room_of[inst.id] = self._room_index[inst.room]
             self._is_wall[inst.id] = inst.kind == "walls"
         self._fixture = {inst.name: inst.id for inst in world.instances if inst.name in house.light_by_id}
-        by_name = {inst.name: inst.id for inst in world.instances}
-        self._windows = [(w, by_name[w.id]) for w in house.windows if w.id in by_name]
 
     # ------------------------------------------------------------------ shading
     def apply(self, rgb: np.ndarray, depth: np.ndarray, instance: np.ndarray, rotation: np.ndarray,
@@ -84,7 +74,7 @@ class Lighting:
         nx, ny, nz = _normals(px, py, z)
         sx, sy, sz = (rotation.T @ np.asarray(sun.direction)).astype(np.float32)
         cos_sun = nx * sx + ny * sy + nz * sz
-        cos_sun = np.clip(cos_sun, -1.0, 1.0) if self._signed else np.maximum(cos_sun, 0.0)
+        cos_sun = np.maximum(cos_sun, 0.0)
         exposure = LAMP_EXPOSURE * (1.0 - DAY_ADAPTATION * float(gain.mean()))
         # Lamp light per unit albedo: pybullet's render is albedo * shade, so divide by the shade.
         per_albedo = exposure / (SUN_AMBIENT + SUN_DIFFUSE * cos_sun)
@@ -124,63 +114,6 @@ class Lighting:
         out = _scale(rgb, gain)
         cv2.copyTo(lit, np.take(lit_rooms[self._room_of], instance), out)   # room -1 -> last entry, 0
         return out
-
-    # ------------------------------------------------------------------ sky
-    def glass_panes(self, depth: np.ndarray, instance: np.ndarray, rotation: np.ndarray,
-                    position: np.ndarray) -> np.ndarray | None:
-        """(H, W) window instance ids where a wall pixel lies inside a window's outline; None if none."""
-        out = None
-        for window, window_id in self._windows:
-            box = self._window_bbox(window, rotation, position)
-            if box is None:
-                continue
-            v0, v1, u0, u1 = box
-            wall = np.take(self._is_wall, instance[v0:v1, u0:u1])
-            if not wall.any():
-                continue
-            z = depth[v0:v1, u0:u1]
-            rx, ry = self._rx[None, u0:u1], self._ry[v0:v1, None]
-            along, across = _window_axes(window)
-            offset = position - np.asarray(window.position)
-            inside = wall
-            # Each window coordinate of a pixel's point is z * (a . R (rx, ry, 1)) + a . offset.
-            for axis, half in ((np.append(along, 0.0), window.width / 2),
-                               (np.append(across, 0.0), window.thickness / 2 + GLASS_MARGIN),
-                               (np.array([0.0, 0.0, 1.0]), window.height / 2)):
-                a = axis @ rotation
-                coord = z * (a[0] * rx + a[1] * ry + a[2]) + float(axis @ offset)
-                inside = inside & (np.abs(coord) <= half)
-            if inside.any():
-                if out is None:
-                    out = np.zeros(instance.shape, np.uint16)
-                out[v0:v1, u0:u1][inside] = window_id
-        return out
-
-    def _window_bbox(self, window, rotation: np.ndarray, position: np.ndarray):
-        """Image rows/columns (v0, v1, u0, u1) covering a window's outline; None when out of view."""
-        along, _ = _window_axes(window)
-        cx, cy, cz = window.position
-        hw, hh = window.width / 2, window.height / 2
-        corners = np.array([[cx + a * along[0] * hw, cy + a * along[1] * hw, cz + b * hh]
-                            for a in (-1, 1) for b in (-1, 1)])
-        cam = (corners - position) @ rotation                               # rows: camera-frame points
-        if (cam[:, 2] <= 0.01).all():
-            return None
-        if (cam[:, 2] <= 0.01).any():
-            return 0, self.height, 0, self.width
-        u = self.fx * cam[:, 0] / cam[:, 2] + self.cx
-        v = self.fy * cam[:, 1] / cam[:, 2] + self.cy
-        u0, u1 = max(int(math.floor(u.min())) - 1, 0), min(int(math.ceil(u.max())) + 2, self.width)
-        v0, v1 = max(int(math.floor(v.min())) - 1, 0), min(int(math.ceil(v.max())) + 2, self.height)
-        if u0 >= u1 or v0 >= v1:
-            return None
-        return v0, v1, u0, u1
-
-
-def _window_axes(window) -> tuple[np.ndarray, np.ndarray]:
-    """Unit vectors along the window's width and across the wall (horizontal, house frame)."""
-    c, s = math.cos(window.yaw), math.sin(window.yaw)
-    return np.array([c, s]), np.array([-s, c])
 
 
 def _lamp(px, py, pz, nx, ny, nz, lx: float, ly: float, lz: float, reach: float) -> np.ndarray:

@@ -3,8 +3,13 @@
 Like gym-pybullet-drones' BaseAviary, one class owns the physics client: it builds the house from a
 :class:`House` and explicit :class:`Resolved` settings, keeps the table of instances (every labelled
 object, door, window and each room's floor, ceiling and walls, each with a unique id and mask colour)
-and changes the house at run time (doors, object models, paint) without rebuilding it. Sensors, robots
-and the node read the world through this class; nothing else talks to this pybullet client directly.
+and changes the house at run time (doors, object models, paint) without rebuilding it.
+
+It also keeps what every body looks like (:attr:`World.visuals`: the mesh, its paint) and a
+:attr:`World.revision` that grows with every visible change, so a renderer (ravh_sim.render) can
+rebuild its GPU copy of the house only when something changed. pybullet's own renderer is used only
+by the TinyRenderer fallback; the EGL plugin is never loaded (one GL context per process belongs to
+ravh_sim.render).
 """
 from __future__ import annotations
 
@@ -12,8 +17,8 @@ import contextlib
 import hashlib
 import math
 import os
-import pkgutil
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterator
 
@@ -21,17 +26,18 @@ import cv2
 import numpy as np
 import pybullet as pb
 
+from ravh_sim.render.backend import resolve_backend
 from ravh_sim.world import paints
 from ravh_sim.world.facing import choose_facing
 from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances
 from ravh_sim.world.furniture import build_model, front_axis
+from ravh_sim.world.mesh import Mesh
 from ravh_sim.world.geometry import quaternion_from_yaw
 from ravh_sim.world.house import Door, House, HouseObject, Wall
 from ravh_sim.world.palette import PALETTE
 from ravh_sim.world.settings import Resolved
 from ravh_sim.world.structure import TexturedMesh, floor_mesh, wall_mesh
 
-RENDERERS = ("auto", "egl", "tiny")
 NON_SOLID_TYPES = frozenset({"Station"})      # drawn, but the robot starts on it
 DOOR_LEAF_THICKNESS = 0.05
 CEILING_PAINT = "white"
@@ -47,22 +53,9 @@ def cache_dir() -> Path:
     return path
 
 
-def connect(renderer: str = "auto") -> tuple[int, str]:
-    """A headless pybullet client with the EGL renderer loaded (unless ``renderer`` is 'tiny');
-    falls back to TinyRenderer with a one-line warning when EGL cannot start.
-    Returns (client, renderer actually used)."""
-    client = pb.connect(pb.DIRECT)
-    if renderer == "tiny":
-        return client, "tiny"
-    loader = pkgutil.get_loader("eglRenderer")
-    plugin = -1
-    if loader is not None:
-        with _quiet_stdout():
-            plugin = pb.loadPlugin(loader.get_filename(), "_eglRendererPlugin", physicsClientId=client)
-    if plugin < 0:
-        print("ravh_sim: EGL rendering unavailable, falling back to TinyRenderer (slower)", file=sys.stderr)
-        return client, "tiny"
-    return client, "egl"
+def connect() -> int:
+    """A headless pybullet client (DIRECT: physics, ray casts and TinyRenderer images)."""
+    return pb.connect(pb.DIRECT)
 
 
 def disconnect(client: int) -> None:
@@ -75,12 +68,13 @@ class World:
 
     def __init__(self, house: House, settings: Resolved, renderer: str = "auto",
                  physics_hz: float = 240.0) -> None:
-        if renderer not in RENDERERS:
-            raise ValueError(f"renderer must be one of {RENDERERS}, got {renderer!r}")
         self.house = house
         self.settings = settings
         self.physics_hz = physics_hz
-        self.client, self.renderer = connect(renderer)
+        self.renderer = resolve_backend(renderer)
+        self.client = connect()
+        self.visuals: dict[int, Visual] = {}     # pybullet body -> what it looks like
+        self.revision = 0                          # grows with every change a camera can see
         pb.setGravity(0, 0, -9.81, physicsClientId=self.client)
         pb.setTimeStep(1.0 / physics_hz, physicsClientId=self.client)
         self._assets = cache_dir()
@@ -145,13 +139,13 @@ class World:
         room = self.house.room(inst.room)
         if inst.kind == "walls":
             walls = [w for w in self.house.walls if w.room == room.id]
-            body = self._mesh_body(wall_mesh(walls), self._wall_collision(walls))
+            body = self._mesh_body(wall_mesh(walls, self.house.windows), self._wall_collision(walls), "walls")
             self._apply_paint(body, self.settings.paint[room.id]["walls"])
         elif inst.kind == "floor":
-            body = self._mesh_body(floor_mesh(room, room.floor_z), -1)
+            body = self._mesh_body(floor_mesh(room, room.floor_z), -1, "floor")
             self._apply_paint(body, self.settings.paint[room.id]["floor"])
         else:
-            body = self._mesh_body(floor_mesh(room, room.ceiling_z, facing_up=False), -1)
+            body = self._mesh_body(floor_mesh(room, room.ceiling_z, facing_up=False), -1, "ceiling")
             self._apply_paint(body, CEILING_PAINT)
         return body
 
@@ -190,18 +184,21 @@ class World:
         pos = (door.position[0], door.position[1], floor + height / 2)
         return self._palette_body(mesh, collision, pos, door.yaw - math.pi / 2)
 
-    def _palette_body(self, mesh, collision: int, position, yaw: float) -> int:
+    def _palette_body(self, mesh: Mesh, collision: int, position, yaw: float) -> int:
         path = self._asset(mesh_bytes(mesh), ".obj", lambda p: mesh.write_obj(p, PALETTE))
         body = self._file_body(path, collision, position, yaw)
         self._set_look(body, self._texture("palette"), [1, 1, 1, 1])
+        self.visuals[body] = Visual(mesh=mesh)
         self.triangle_count += mesh.triangle_count
         return body
 
-    def _mesh_body(self, mesh: TexturedMesh, collision: int) -> int:
+    def _mesh_body(self, mesh: TexturedMesh, collision: int, surface: str) -> int:
         key = np.concatenate([mesh.vertices.ravel(), mesh.uvs.ravel()]).round(4).tobytes()
         path = self._asset(key, ".obj", mesh.write_obj)
         self.triangle_count += mesh.triangle_count
-        return self._file_body(path, collision, (0, 0, 0), 0.0)
+        body = self._file_body(path, collision, (0, 0, 0), 0.0)
+        self.visuals[body] = Visual(structure=mesh, surface=surface)
+        return body
 
     def _file_body(self, path: Path, collision: int, position, yaw: float) -> int:
         visual = pb.createVisualShape(pb.GEOM_MESH, fileName=str(path), physicsClientId=self.client)
@@ -233,6 +230,8 @@ class World:
         return self._textures[name]
 
     def _apply_paint(self, body: int, paint: str) -> None:
+        self.visuals[body].paint = paint
+        self.revision += 1
         if paints.is_texture(paint):
             texture, rgba = self._texture(paint), [1, 1, 1, 1]
         else:
@@ -263,13 +262,16 @@ class World:
                                            quaternion_from_yaw(door.yaw - math.pi / 2),
                                            physicsClientId=self.client)
         self.settings.doors[door_id] = is_open
+        self.revision += 1
 
     def set_object_model(self, object_id: str, model: int) -> None:
         """Swap an object's model variant (its visual and its collision box)."""
         inst = self._by_name[object_id]
         obj = self.house.object(object_id)
         pb.removeBody(inst.body, physicsClientId=self.client)
+        del self.visuals[inst.body]
         inst.body = self._object_body(obj, model)
+        self.revision += 1
         self.settings.models[object_id] = model
         if inst.kind == "door":
             self.set_door_open(object_id, self.settings.doors[object_id])
@@ -285,6 +287,16 @@ class World:
         pos, orn = pb.getBasePositionAndOrientation(self._by_name[name].body, physicsClientId=self.client)
         return tuple(pos), tuple(orn)
 
+
+
+@dataclass
+class Visual:
+    """What a body looks like: a palette-coloured model (in its body frame) or a painted piece of
+    structure (in the house frame) with its current paint."""
+    mesh: Mesh | None = None
+    structure: TexturedMesh | None = None
+    surface: str = ""                      # walls | floor | ceiling for structure
+    paint: str = ""
 
 
 @contextlib.contextmanager

@@ -2,18 +2,20 @@
 
 Unlike furniture (coloured through the palette texture), structure is painted: a plain colour or a
 tiling texture, so its UVs run in world metres divided by the texture's tile size and the renderer
-repeats the texture. Flat normals, one OBJ per room and surface.
+repeats the texture. Flat normals, one OBJ per room and surface. Walls have openings where windows
+are.
 """
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ravh_sim.world.geometry import triangulate
-from ravh_sim.world.house import Room, Wall
+from ravh_sim.world.house import Room, Wall, Window
 from ravh_sim.world.paints import TEXTURE_TILE_M
 
 
@@ -58,9 +60,60 @@ def floor_mesh(room: Room, z: float, facing_up: bool = True) -> TexturedMesh:
     return merge(parts)
 
 
-def wall_mesh(walls: list[Wall]) -> TexturedMesh:
-    """Every wall piece of a room as a box, the texture running along each wall."""
-    return merge([_wall_box(w) for w in walls])
+def wall_mesh(walls: list[Wall], windows: Sequence[Window] = ()) -> TexturedMesh:
+    """Every wall piece of a room as a box, the texture running along each wall, with a real
+    opening where a window sits in it (the window model fills the opening; the outdoors shows
+    through its glass)."""
+    pieces: list[Wall] = []
+    for w in walls:
+        pieces += _cut_windows(w, [win for win in windows if _on_wall(win, w)])
+    return merge([_wall_box(w) for w in pieces])
+
+
+def _on_wall(window: Window, wall: Wall) -> bool:
+    """Whether a window's centre lies inside a wall piece, its width along the wall."""
+    if wall.kind != "wall" or wall.length < 1e-6:
+        return False
+    (ax, ay), (bx, by) = wall.a, wall.b
+    dx, dy = (bx - ax) / wall.length, (by - ay) / wall.length
+    px, py = window.position[0] - ax, window.position[1] - ay
+    along, across = px * dx + py * dy, abs(-px * dy + py * dx)
+    parallel = abs(math.cos(window.yaw) * dy - math.sin(window.yaw) * dx) < 0.1
+    return parallel and across <= wall.thickness / 2 + 0.05 and 0.0 < along < wall.length \
+        and wall.z0 < window.position[2] < wall.z1
+
+
+def _cut_windows(wall: Wall, windows: list[Window]) -> list[Wall]:
+    """The wall split into full-height pieces beside each window and pieces below and above it."""
+    if not windows:
+        return [wall]
+    (ax, ay), (bx, by) = wall.a, wall.b
+    dx, dy = (bx - ax) / wall.length, (by - ay) / wall.length
+
+    def point(t: float) -> tuple[float, float]:
+        return ax + dx * t, ay + dy * t
+
+    def piece(t0: float, t1: float, z0: float, z1: float) -> Wall:
+        return Wall(point(t0), point(t1), wall.thickness, z0, z1, wall.room, wall.kind)
+
+    out, t = [], 0.0
+    for win in sorted(windows, key=lambda v: (v.position[0] - ax) * dx + (v.position[1] - ay) * dy):
+        centre = (win.position[0] - ax) * dx + (win.position[1] - ay) * dy
+        t0, t1 = max(centre - win.width / 2, t), min(centre + win.width / 2, wall.length)
+        z0 = max(win.position[2] - win.height / 2, wall.z0)
+        z1 = min(win.position[2] + win.height / 2, wall.z1)
+        if t1 - t0 < 1e-3 or z1 - z0 < 1e-3:
+            continue
+        if t0 - t > 1e-3:
+            out.append(piece(t, t0, wall.z0, wall.z1))
+        if z0 - wall.z0 > 1e-3:
+            out.append(piece(t0, t1, wall.z0, z0))
+        if wall.z1 - z1 > 1e-3:
+            out.append(piece(t0, t1, z1, wall.z1))
+        t = t1
+    if wall.length - t > 1e-3:
+        out.append(piece(t, wall.length, wall.z0, wall.z1))
+    return out
 
 
 def _wall_box(w: Wall) -> TexturedMesh:

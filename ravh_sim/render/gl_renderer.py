@@ -1,0 +1,429 @@
+"""ravh_sim's physically based OpenGL renderer (moderngl on the process's EGL context).
+
+One forward pass shades each pixel once (the cost on a CPU rasteriser is fragments, see
+shared/notes/rendering-probe.md) and writes three aligned targets from the same triangles: HDR
+colour, z-depth in metres and the instance id, so depth, masks and RGB can never disagree. The
+expensive light transport is computed when the scene changes, not per frame: the sun's shadow map
+(orthographic over the house; the ceiling and walls shadow the rooms, so sunlight enters only
+through the window openings), one cube shadow map per switched-on lamp (walls confine its light;
+open doors let it through) and a top-down coverage map that gives floors their ambient occlusion.
+Per frame: the pass, the procedural sky behind the windows, mipmaps for auto-exposure and a tone
+map (ACES, sRGB). ``fast`` quality skips shadow look-ups and confines lamps to their room instead.
+
+Light units are arbitrary but consistent (exposure adapts): the sun gives SUN_IRRADIANCE on a
+surface facing it at noon, a lamp of intensity 1 gives LAMP_POWER / d^2.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from importlib import resources
+
+import cv2
+import numpy as np
+
+from ravh_sim.render.backend import gl_context
+from ravh_sim.render.geometry import ATTRIBUTES, VERTEX_FORMAT, SceneBuilder
+from ravh_sim.render.materials import NOISE_TEXELS, PATTERN, TEXELS, MaterialTable, noise_volume, srgb_to_linear
+from ravh_sim.render.projection import look_at, orthographic, perspective, projection_from_K, view_matrix
+from ravh_sim.world.appearance import SunLight, sun_light
+from ravh_sim.world.house import Light
+from ravh_sim.world.scene import World
+
+KINDS = {"floor": 0, "ceiling": 1, "walls": 2, "object": 3, "door": 4, "window": 5}
+MAX_LIGHTS = 32                       # switched-on lights with a shadow map
+FRAME_LIGHTS = 6                      # lights shading one frame (the nearest)
+FRAME_LIGHT_REACH = 9.0               # m: lights farther from the camera are left out of a frame
+SUN_SHADOW_TEXELS = 2048
+LAMP_TILE = 192                       # texels per cube face of a lamp's shadow map
+COVERAGE_TEXELS = 512
+COVERAGE_BLUR_M = 0.12                # sigma of the floor occlusion blur
+
+SUN_IRRADIANCE = 9.0                  # noon sun on a surface facing it
+SKY_AMBIENT = 0.55                    # sky light of a room with generous windows, by day
+MIN_OPENNESS = 0.25                   # rooms without windows still get light through their doors
+WINDOW_REACH = 6.0                    # window area x this / floor area = fully open room
+LAMP_POWER = 2.2                      # irradiance of an intensity-1 lamp at 1 m
+AMBIENT_TINT = 0.35                   # share of the daylight colour that survives bouncing indoors
+LAMP_BOUNCE = 0.35                    # share of a lamp's power that comes back as room ambient (/m^2)
+FIXTURE_GLOW = 6.0                    # radiance of a switched-on lamp shade or bulb
+NIGHT_FLOOR = 0.004                   # ambient that never goes away (moon, street lights)
+EXPOSURE_KEY = 0.2                    # mid-grey target of auto-exposure
+EXPOSURE_REFERENCE = 0.5              # log-average luminance of a daylit room
+EXPOSURE_ADAPTATION = 0.5             # how much of a brightness change exposure undoes (1 = all)
+EXPOSURE_RANGE = (0.08, 5.0)          # a camera's exposure limits: night stays dark
+METER_BLOCK = 16                      # pixels per side averaged by one metering texel
+
+
+@dataclass
+class RenderedViews:
+    rgb: np.ndarray                   # (H, W, 3) uint8, tone-mapped sRGB
+    depth: np.ndarray                 # (H, W) float32 z-depth in metres, NaN = nothing
+    instance: np.ndarray              # (H, W) uint16, 0 = nothing
+    background: np.ndarray            # (H, W) bool: the outdoors (sky, ground), no body
+
+
+def _source(name: str) -> str:
+    return (resources.files("ravh_sim.render") / "shaders" / name).read_text()
+
+
+def _header(pattern: int = -1) -> str:
+    defines = [f"#define PATTERN_{name.upper()} {i}" for name, i in PATTERN.items()]
+    defines.append(f"#define PATTERN_ID {pattern}")
+    defines += [f"#define KIND_{name.upper()} {i}" for name, i in KINDS.items()]
+    defines.append(f"#define MAX_LIGHTS {MAX_LIGHTS}")
+    return "#version 430\n" + "\n".join(defines) + "\n" + _source("common.glsl") + "\n"
+
+
+def _mat(m: np.ndarray) -> bytes:
+    """A row-major numpy matrix as the column-major bytes GL wants."""
+    return np.ascontiguousarray(m.T, dtype=np.float32).tobytes()
+
+
+class GLRenderer:
+    """Renders one World for one camera model (K, size, clip planes) at one quality."""
+
+    def __init__(self, world: World, K: np.ndarray, width: int, height: int, near: float, far: float,
+                 quality: str = "realistic") -> None:
+        ctx = gl_context()
+        if ctx is None:
+            raise RuntimeError("no OpenGL context: use the tiny renderer")
+        self.ctx, self.world = ctx, world
+        self.width, self.height, self.near, self.far = width, height, near, far
+        self.shadows = quality == "realistic"
+        self.projection = projection_from_K(K, width, height, near, far)
+        self.materials = MaterialTable()
+        self.builder = SceneBuilder(world, self.materials)
+        header = _header()
+        self.scene_programs = {k: ctx.program(vertex_shader=header + _source("scene.vert"),
+                                              fragment_shader=_header(k) + _source("scene.frag"))
+                               for k in range(len(PATTERN))}
+        self.depth_program = ctx.program(vertex_shader=header + _source("scene.vert"),
+                                         fragment_shader=header + "void main() {}\n")
+        self._ranges: list[tuple[int, int, int]] = []      # (pattern, first vertex, vertex count)
+        self._lights: list[Light] = []
+        self.sky_program = ctx.program(vertex_shader=header + _source("fullscreen.vert"),
+                                       fragment_shader=header + _source("sky.frag"))
+        self.tonemap_program = ctx.program(vertex_shader=header + _source("fullscreen.vert"),
+                                           fragment_shader=header + _source("tonemap.frag"))
+        self.meter_program = ctx.program(vertex_shader=header + _source("fullscreen.vert"),
+                                         fragment_shader=header + _source("meter.frag"))
+        self.shadow_program = ctx.program(vertex_shader=header + _source("shadow.vert"),
+                                          fragment_shader=header + _source("shadow.frag"))
+        self.coverage_program = ctx.program(vertex_shader=header + _source("coverage.vert"),
+                                            fragment_shader=header + _source("coverage.frag"))
+        self.empty_vao = ctx.vertex_array(self.sky_program, [])
+        self.tonemap_vao = ctx.vertex_array(self.tonemap_program, [])
+        self.meter_vao = ctx.vertex_array(self.meter_program, [])
+        size = (width, height)
+        self.hdr = ctx.texture(size, 4, dtype="f2")
+        self.depth = ctx.texture(size, 1, dtype="f4")
+        self.instance = ctx.texture(size, 1, dtype="i4")
+        for texture in (self.depth, self.instance):
+            texture.filter = (ctx.NEAREST, ctx.NEAREST)
+        self.main_fbo = ctx.framebuffer([self.hdr, self.depth, self.instance], ctx.depth_renderbuffer(size))
+        self.ldr = ctx.texture(size, 4)
+        self.ldr_fbo = ctx.framebuffer([self.ldr])
+        meter_size = (-(-width // METER_BLOCK), -(-height // METER_BLOCK))
+        self.meter = ctx.texture(meter_size, 1, dtype="f4")
+        self.meter_fbo = ctx.framebuffer([self.meter])
+        self.sun_depth = ctx.depth_texture((SUN_SHADOW_TEXELS, SUN_SHADOW_TEXELS))
+        self.sun_depth.compare_func = "<="
+        self.sun_depth.filter = (ctx.LINEAR, ctx.LINEAR)
+        self.sun_fbo = ctx.framebuffer(depth_attachment=self.sun_depth)
+        self.coverage_raw = ctx.texture((COVERAGE_TEXELS, COVERAGE_TEXELS), 1, dtype="f4")
+        self.coverage_fbo = ctx.framebuffer([self.coverage_raw])
+        self.coverage = ctx.texture((COVERAGE_TEXELS, COVERAGE_TEXELS), 1, dtype="f4")
+        self.coverage.repeat_x = self.coverage.repeat_y = False
+        self.noise = ctx.texture3d((NOISE_TEXELS,) * 3, 4, noise_volume().tobytes())
+        self.noise.repeat_x = self.noise.repeat_y = self.noise.repeat_z = True
+
+        self.atlas = None
+        self.atlas_fbo = None
+        self.vbo = None
+        self.vaos: dict[str, object] = {}
+        self._geometry_revision = -1
+        self._light_key: tuple | None = None
+        self._bounds = (np.zeros(3), np.ones(3))
+        self._sun_matrix = np.eye(4)
+
+    def release(self) -> None:
+        """Free the GPU objects (the context stays: it belongs to the process)."""
+        for obj in (*self.scene_programs.values(), self.depth_program, self.sky_program, self.tonemap_program, self.shadow_program,
+                    self.coverage_program, self.meter_program, self.meter, self.meter_fbo, self.hdr, self.depth, self.instance, self.main_fbo, self.ldr,
+                    self.ldr_fbo, self.sun_depth, self.sun_fbo, self.coverage_raw, self.coverage_fbo,
+                    self.coverage, self.noise, self.atlas, self.atlas_fbo, self.vbo, *self.vaos.values()):
+            if obj is not None:
+                obj.release()
+
+    # ------------------------------------------------------------------ scene state
+    def _sync(self) -> None:
+        """Bring GPU geometry, light state and shadow maps up to date with the World."""
+        world = self.world
+        geometry_changed = world.revision != self._geometry_revision
+        if geometry_changed:
+            self._upload_geometry()
+            self._geometry_revision = world.revision
+            self._render_coverage()
+        on = tuple(sorted(k for k, v in world.settings.lights.items() if v))
+        key = (world.revision, world.settings.sun_angle, on)
+        if key != self._light_key:
+            sun = sun_light(world.settings.sun_angle)
+            lights = [lt for lt in world.house.lights if world.settings.lights.get(lt.id, False)][:MAX_LIGHTS]
+            self._upload_instances(sun, lights)
+            self._set_lighting(sun, lights)
+            if self.shadows:
+                self._render_sun_shadow(sun)
+                self._render_lamp_shadows(lights)
+            self._light_key = key
+
+    def _upload_geometry(self) -> None:
+        vertices = self.builder.build()
+        patterns = np.array([PATTERN[m.pattern] for m in self.materials.materials])
+        triangle_pattern = patterns[vertices[::3, 9].astype(np.int64)]
+        order = np.argsort(triangle_pattern, kind="stable")
+        vertices = vertices.reshape(-1, 3, vertices.shape[1])[order].reshape(vertices.shape)
+        counts = np.bincount(triangle_pattern, minlength=len(PATTERN))
+        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        self._ranges = [(k, 3 * int(starts[k]), 3 * int(counts[k])) for k in range(len(PATTERN)) if counts[k]]
+        positions = vertices[:, :3]
+        self._bounds = (positions.min(axis=0), positions.max(axis=0))
+        if self.vbo is not None:
+            self.vbo.release()
+            for vao in self.vaos.values():
+                vao.release()
+        self.vbo = self.ctx.buffer(vertices.tobytes())
+        skip = "3f 3x4 3x4 1f 1x4"
+        self.vaos = {
+            **{f"scene{k}": self.ctx.vertex_array(self.scene_programs[k], [(self.vbo, VERTEX_FORMAT, *ATTRIBUTES)])
+               for k, _, _ in self._ranges},
+            "depth": self.ctx.vertex_array(self.depth_program, [(self.vbo, "3f 32x", "in_position")]),
+            "shadow": self.ctx.vertex_array(self.shadow_program, [(self.vbo, skip, "in_position", "in_material")]),
+            "coverage": self.ctx.vertex_array(self.coverage_program, [
+                (self.vbo, "3f 3x4 3x4 1x4 1f", "in_position", "in_instance")]),
+        }
+        table = self.materials.pack()
+        self.material_texture = self.ctx.texture((TEXELS, len(table)), 4, table.tobytes(), dtype="f4")
+        self.material_texture.filter = (self.ctx.NEAREST, self.ctx.NEAREST)
+
+    def _upload_instances(self, sun: SunLight, lights: list[Light]) -> None:
+        """Per instance: the room's ambient light and index, a fixture's glow and the kind, the
+        room's floor and ceiling heights."""
+        house, world = self.world.house, self.world
+        rooms = {room.id: i for i, room in enumerate(house.rooms)}
+        ambient = {room.id: self._room_ambient(room, sun, lights) for room in house.rooms}
+        glow = {lt.id: np.asarray(lt.color) * FIXTURE_GLOW * max(lt.intensity, 0.3) for lt in lights}
+        size = max(inst.id for inst in world.instances) + 1
+        data = np.zeros((3, size, 4), np.float32)
+        for inst in world.instances:
+            room = house.room(inst.room)
+            data[0, inst.id] = (*ambient[inst.room], rooms[inst.room])
+            data[1, inst.id] = (*glow.get(inst.name, (0.0, 0.0, 0.0)), KINDS[inst.kind])
+            data[2, inst.id, :2] = (room.floor_z, room.ceiling_z)
+        if getattr(self, "instance_texture", None) is not None:
+            self.instance_texture.release()
+        self.instance_texture = self.ctx.texture((size, 3), 4, data.tobytes(), dtype="f4")
+        self.instance_texture.filter = (self.ctx.NEAREST, self.ctx.NEAREST)
+
+    def _room_ambient(self, room, sun: SunLight, lights: list[Light]) -> np.ndarray:
+        """Sky light through the room's windows plus the bounce of its own lamps. Indoors, light
+        has bounced off white ceilings and walls, so it keeps only part of the daylight's colour
+        (the direct sun keeps all of it: a sunset paints patches, not the whole room)."""
+        house = self.world.house
+        window_area = sum(w.width * w.height for w in house.windows if w.room == room.id)
+        openness = max(MIN_OPENNESS, min(1.0, WINDOW_REACH * window_area / max(room.area, 1.0)))
+        gain = np.asarray(sun.gain)
+        level = float(gain.mean())
+        tint = level * (1.0 - AMBIENT_TINT) + gain * AMBIENT_TINT
+        bounce = sum((np.asarray(lt.color) * lt.intensity for lt in lights if lt.room == room.id), np.zeros(3))
+        return SKY_AMBIENT * openness * tint + LAMP_POWER * LAMP_BOUNCE * bounce / max(room.area, 4.0) \
+            + NIGHT_FLOOR
+
+    def _set_lighting(self, sun: SunLight, lights: list[Light]) -> None:
+        direction = np.asarray(sun.direction)
+        elevation = math.degrees(math.asin(max(-1.0, min(1.0, direction[2]))))
+        sun_up = min(1.0, max(0.0, elevation / 2.0 + 0.5)) if sun.angle <= 180.0 else 0.25
+        irradiance = SUN_IRRADIANCE * np.asarray(sun.gain) * sun_up
+        sky = np.asarray(srgb_to_linear(tuple(c / 255 for c in sun.sky)))
+        level = float(np.mean(sun.gain))
+        uniforms = {
+            "u_sun_dir": tuple(direction), "u_sun_irradiance": tuple(irradiance),
+            "u_sun_radiance": tuple(irradiance * 4.0),
+            "u_sky_zenith": tuple(sky * 1.6), "u_sky_horizon": tuple(sky * 0.8 + 0.6 * np.asarray(sun.gain)),
+            "u_ground": tuple(np.array([0.16, 0.2, 0.1]) * level * 1.4),
+            "u_facade": tuple(np.array([0.55, 0.5, 0.45]) * np.asarray(sun.gain) * 1.3),
+        }
+        for name, value in uniforms.items():
+            self._set(name, value, also=(self.sky_program,))
+        self._set("u_shadows", int(self.shadows))
+        self._lights = lights
+
+    def _set(self, name: str, value, also: tuple = ()) -> None:
+        """Set a uniform on every scene program (and ``also``) that uses it; bytes are written raw."""
+        for program in (*self.scene_programs.values(), *also):
+            if name in program:
+                if isinstance(value, bytes):
+                    program[name].write(value)
+                else:
+                    program[name].value = value
+
+    def _set_frame_lights(self, position: np.ndarray) -> None:
+        """The lamps that can light this view: the nearest FRAME_LIGHTS switched-on ones within
+        FRAME_LIGHT_REACH (a CPU rasteriser pays for every light on every pixel)."""
+        index = {room.id: i for i, room in enumerate(self.world.house.rooms)}
+        near = sorted((float(np.linalg.norm(np.asarray(lt.position) - position)), row, lt)
+                      for row, lt in enumerate(self._lights))
+        chosen = [(row, lt) for d, row, lt in near if d < FRAME_LIGHT_REACH][:FRAME_LIGHTS]
+        positions = np.zeros((MAX_LIGHTS, 4), np.float32)
+        powers = np.zeros((MAX_LIGHTS, 4), np.float32)
+        rooms = np.zeros(MAX_LIGHTS, np.float32)
+        for i, (row, lt) in enumerate(chosen):
+            positions[i] = (*lt.position, lt.range)
+            powers[i] = (*(np.asarray(lt.color) * lt.intensity * LAMP_POWER), row if self.shadows else -1)
+            rooms[i] = index[lt.room]
+        self._set("u_light_count", len(chosen))
+        self._set("u_light_position", positions.tobytes())
+        self._set("u_light_power", powers.tobytes())
+        self._set("u_light_room", rooms.tobytes())
+
+    # ------------------------------------------------------------------ precomputed light
+    def _render_sun_shadow(self, sun: SunLight) -> None:
+        lo, hi = self._bounds
+        centre = (lo + hi) / 2
+        radius = float(np.linalg.norm(hi - lo)) / 2 + 0.5
+        direction = np.asarray(sun.direction)
+        up = np.array([0.0, 0.0, 1.0]) if abs(direction[2]) < 0.99 else np.array([0.0, 1.0, 0.0])
+        view = look_at(-direction, up)
+        view[:3, 3] = -view[:3, :3] @ (centre + direction * radius * 2)
+        projection = orthographic(-radius, radius, -radius, radius, 0.1, radius * 4)
+        matrix = projection @ view
+        bias = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5], [0, 0, 0, 1]])
+        self._sun_matrix = bias @ matrix
+        self.sun_fbo.use()
+        self.sun_fbo.clear(depth=1.0)
+        self._draw_casters(matrix, np.zeros(3))
+
+    def _draw_casters(self, matrix: np.ndarray, origin: np.ndarray) -> None:
+        ctx = self.ctx
+        ctx.enable(ctx.DEPTH_TEST)
+        ctx.disable(ctx.CULL_FACE)
+        self.material_texture.use(0)
+        self.shadow_program["u_materials"].value = 0
+        self.shadow_program["u_matrix"].write(_mat(matrix))
+        self.shadow_program["u_origin"].value = tuple(float(v) for v in origin)
+        self.vaos["shadow"].render()
+
+    def _render_lamp_shadows(self, lights: list[Light]) -> None:
+        rows = max(len(lights), 1)
+        size = (6 * LAMP_TILE, rows * LAMP_TILE)
+        if self.atlas is None or self.atlas.size != size:
+            for obj in (self.atlas, self.atlas_fbo):
+                if obj is not None:
+                    obj.release()
+            self.atlas = self.ctx.texture(size, 1, dtype="f4")
+            self.atlas.filter = (self.ctx.NEAREST, self.ctx.NEAREST)
+            self.atlas_fbo = self.ctx.framebuffer([self.atlas], self.ctx.depth_renderbuffer(size))
+        self.atlas_fbo.use()
+        self.atlas_fbo.viewport = (0, 0, *size)
+        self.atlas_fbo.clear(1e4, 1e4, 1e4, 1e4, depth=1.0)
+        for row, lt in enumerate(lights):
+            for face, matrix in enumerate(self._face_matrices(lt.range)):
+                self.atlas_fbo.viewport = (face * LAMP_TILE, row * LAMP_TILE, LAMP_TILE, LAMP_TILE)
+                self._draw_casters(matrix, np.asarray(lt.position))
+        self._set("u_face_matrix", b"".join(_mat(m) for m in self._face_matrices(1.0)))
+        self._set("u_atlas_texels", (float(size[0]), float(size[1])))
+        self._set("u_tile", float(LAMP_TILE))
+
+    @staticmethod
+    def _face_matrices(reach: float) -> list[np.ndarray]:
+        """View-projections of the six cube faces (+x, -x, +y, -y, +z, -z) around a lamp at the origin."""
+        projection = perspective(math.pi / 2, 1.0, 0.02, max(reach, 0.1))
+        axes = [((1, 0, 0), (0, 0, 1)), ((-1, 0, 0), (0, 0, 1)), ((0, 1, 0), (0, 0, 1)),
+                ((0, -1, 0), (0, 0, 1)), ((0, 0, 1), (0, 1, 0)), ((0, 0, -1), (0, 1, 0))]
+        return [projection @ look_at(np.array(f, float), np.array(u, float)) for f, u in axes]
+
+    def _render_coverage(self) -> None:
+        lo, hi = self._bounds
+        span = max(hi[0] - lo[0], hi[1] - lo[1]) + 1.0
+        x0, y0 = (lo[0] + hi[0] - span) / 2, (lo[1] + hi[1] - span) / 2
+        view = look_at(np.array([0.0, 0.0, -1.0]), np.array([0.0, 1.0, 0.0]))
+        view[:3, 3] = -view[:3, :3] @ np.array([0.0, 0.0, hi[2] + 1.0])
+        matrix = orthographic(x0, x0 + span, y0, y0 + span, 0.1, hi[2] - lo[2] + 2.0) @ view
+        ctx = self.ctx
+        self.coverage_fbo.use()
+        self.coverage_fbo.clear(0.0, 0.0, 0.0, 0.0)
+        ctx.disable(ctx.DEPTH_TEST)
+        ctx.disable(ctx.CULL_FACE)
+        self._upload_instances(sun_light(self.world.settings.sun_angle), [])
+        self.instance_texture.use(0)
+        self.coverage_program["u_instances"].value = 0
+        self.coverage_program["u_matrix"].write(_mat(matrix))
+        self.vaos["coverage"].render()
+        raw = np.frombuffer(self.coverage_raw.read(), np.float32).reshape(COVERAGE_TEXELS, COVERAGE_TEXELS)
+        sigma = COVERAGE_BLUR_M * COVERAGE_TEXELS / span
+        blurred = cv2.GaussianBlur(np.ascontiguousarray(raw), (0, 0), sigma)
+        self.coverage.write(np.ascontiguousarray(blurred, np.float32).tobytes())
+        self._set("u_coverage_box", (x0, y0, 1.0 / span, 1.0 / span))
+
+    # ------------------------------------------------------------------ frames
+    def _exposure(self) -> float:
+        """Auto-exposure: the frame's log-average luminance is metered and exposure makes up for
+        part of its difference from a daylit room (a camera keeps a dusk room dimmer than a noon
+        one), within the camera's range (so a dark room stays dark instead of turning grey)."""
+        average = math.exp(float(np.frombuffer(self.meter.read(), np.float32).mean()))
+        adapted = EXPOSURE_REFERENCE * (average / EXPOSURE_REFERENCE) ** EXPOSURE_ADAPTATION
+        return float(np.clip(EXPOSURE_KEY / adapted, *EXPOSURE_RANGE))
+
+    def render(self, position: np.ndarray, rotation: np.ndarray) -> RenderedViews:
+        """RGB, depth and instance images from an optical frame (rotation columns: x right, y down,
+        z forward) in the house frame."""
+        self._sync()
+        ctx = self.ctx
+        view = view_matrix(position, rotation)
+        view_proj = self.projection @ view
+        self._set("u_view_proj", _mat(view_proj))
+        self._set("u_view", _mat(view))
+        self._set("u_eye", tuple(float(v) for v in position))
+        self._set("u_sun_matrix", _mat(self._sun_matrix))
+        self._set_frame_lights(position)
+        self.material_texture.use(0)
+        self.instance_texture.use(1)
+        self.sun_depth.use(2)
+        (self.atlas if self.atlas is not None else self.depth).use(3)
+        self.coverage.use(4)
+        self.noise.use(5)
+        for name, unit in (("u_materials", 0), ("u_instances", 1), ("u_sun_shadow", 2),
+                           ("u_point_shadow", 3), ("u_coverage", 4), ("u_noise", 5)):
+            self._set(name, unit, also=(self.sky_program,))
+        self.main_fbo.use()
+        self.main_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        ctx.enable(ctx.DEPTH_TEST)
+        ctx.disable(ctx.CULL_FACE)
+        # Depth first, then shade only the surviving fragment of each pixel (no overdraw).
+        ctx.depth_func = "<"
+        self.depth_program["u_view_proj"].write(_mat(view_proj))
+        self.vaos["depth"].render()
+        ctx.depth_func = "=="
+        for k, first, count in self._ranges:
+            self.vaos[f"scene{k}"].render(first=first, vertices=count)
+        ctx.depth_func = "<="
+        self.sky_program["u_inverse_view_proj"].write(_mat(np.linalg.inv(view_proj)))
+        self.empty_vao.render(vertices=3)
+        ctx.depth_func = "<"
+        ctx.disable(ctx.DEPTH_TEST)
+        self.hdr.use(0)
+        self.meter_fbo.use()
+        self.meter_program["u_hdr"].value = 0
+        self.meter_program["u_block"].value = METER_BLOCK
+        self.meter_vao.render(vertices=3)
+        self.ldr_fbo.use()
+        self.tonemap_program["u_hdr"].value = 0
+        self.tonemap_program["u_exposure"].value = self._exposure()
+        self.tonemap_vao.render(vertices=3)
+        h, w = self.height, self.width
+        rgb = np.frombuffer(self.ldr_fbo.read(components=3), np.uint8).reshape(h, w, 3)[::-1]
+        depth = np.frombuffer(self.depth.read(), np.float32).reshape(h, w)[::-1].copy()
+        instance = np.frombuffer(self.instance.read(), np.int32).reshape(h, w)[::-1]
+        background = instance == 0
+        depth[background | (depth > self.far)] = np.nan
+        return RenderedViews(np.ascontiguousarray(rgb), depth, instance.astype(np.uint16), background)

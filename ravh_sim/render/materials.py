@@ -1,0 +1,160 @@
+"""Physically based materials for every palette colour and paint, as the GPU reads them.
+
+Why: the furniture library colours each face with a named palette colour ("wood_dark", "fabric_blue",
+"chrome"...) and rooms are painted with named paints ("parquet", "tiles", "#a0b0c0"). The name already
+says what the surface is made of, so the material follows from it: base colour, roughness, metalness
+and a procedural pattern (wood grain, weave, grout...) that the fragment shader evaluates in the
+surface's own coordinates. No image files: every pattern is a function of position and a seed.
+
+The table is uploaded as a small float texture: one row of :data:`TEXELS` texels per material.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ravh_sim.world import paints
+from ravh_sim.world.palette import PALETTE
+
+RGB = tuple[float, float, float]
+
+# Pattern ids, mirrored by the PATTERN_* constants in shaders/scene.frag.
+PATTERNS = ("plain", "plaster", "wood", "parquet", "tiles", "marble", "fabric", "leather", "carpet",
+            "brick", "concrete", "metal", "glass", "mirror", "screen", "ceramic", "foliage", "emissive")
+PATTERN = {name: i for i, name in enumerate(PATTERNS)}
+TEXELS = 3                                   # texels per material row (see pack)
+
+
+@dataclass(frozen=True)
+class Material:
+    colour: RGB                              # linear base colour
+    pattern: str = "plain"
+    roughness: float = 0.6
+    metalness: float = 0.0
+    scale: float = 1.0                       # pattern repeats per metre (wood: rings per metre)
+    variation: float = 0.15                  # how much the pattern varies the base colour
+    accent: RGB = (0.0, 0.0, 0.0)            # second colour: grout, veins, dark grain, mortar
+    bump: float = 0.3                        # strength of the pattern's normal detail
+
+
+def srgb_to_linear(rgb: RGB) -> RGB:
+    c = np.asarray(rgb, np.float64)
+    return tuple(float(v) for v in np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4))
+
+
+def _scaled(rgb: RGB, k: float) -> RGB:
+    return tuple(min(1.0, c * k) for c in rgb)
+
+
+def palette_material(name: str, srgb: RGB) -> Material:
+    """The material a palette colour stands for, from its name."""
+    c = srgb_to_linear(srgb)
+    if name.startswith("wood"):
+        return Material(c, "wood", 0.55, scale=9.0, variation=0.35, accent=_scaled(c, 0.55), bump=0.25)
+    if name.startswith("fabric") or name in ("mattress", "pillow"):
+        return Material(c, "fabric", 0.92, scale=260.0, variation=0.18, accent=_scaled(c, 0.7), bump=0.5)
+    if name.startswith("leather"):
+        return Material(c, "leather", 0.42, scale=120.0, variation=0.2, accent=_scaled(c, 0.6), bump=0.35)
+    if name in ("metal", "steel", "chrome", "brass"):
+        rough = {"chrome": 0.12, "brass": 0.3}.get(name, 0.32)
+        return Material(c, "metal", rough, metalness=1.0, scale=400.0, variation=0.08, bump=0.1)
+    if name in ("glass", "glass_dark"):
+        return Material(c, "glass", 0.05, scale=1.0, variation=0.0)
+    if name == "mirror":
+        return Material(c, "mirror", 0.03, metalness=1.0, variation=0.0)
+    if name == "screen":
+        return Material(c, "screen", 0.12, variation=0.0)
+    if name.startswith("ceramic") or name in ("white",):
+        return Material(c, "ceramic", 0.18 if name.startswith("ceramic") else 0.45, variation=0.03,
+                        scale=3.0)
+    if name in ("marble", "granite"):
+        return Material(c, "marble", 0.2, scale=2.5, variation=0.3, accent=_scaled(c, 0.45))
+    if name.startswith("plant") or name.startswith("fruit"):
+        return Material(c, "foliage", 0.6, scale=25.0, variation=0.35, accent=_scaled(c, 0.5), bump=0.4)
+    if name in ("bulb", "lamp_shade", "led"):
+        return Material(c, "emissive", 0.7, variation=0.05, scale=40.0)
+    if name.startswith("black") or name.startswith("charcoal") or name.startswith("grey"):
+        return Material(c, "plain", 0.5, variation=0.06, scale=6.0)      # plastics and paints
+    return Material(c, "plain", 0.6, variation=0.08, scale=5.0)
+
+
+def paint_material(paint: str, surface: str) -> Material:
+    """A wall, floor or ceiling paint: a plain colour is plaster on walls and ceilings and a matt
+    finish on floors; texture paints are the material they name."""
+    if paints.is_texture(paint):
+        return _TEXTURE_PAINTS[paint]
+    c = srgb_to_linear(tuple(v / 255 for v in paints.plain_rgb(paint)))
+    if surface == "floor":
+        return Material(c, "concrete", 0.7, scale=1.5, variation=0.12, accent=_scaled(c, 0.8), bump=0.2)
+    return Material(c, "plaster", 0.85, scale=3.0, variation=0.05, accent=_scaled(c, 0.9), bump=0.25)
+
+
+_TEXTURE_PAINTS: dict[str, Material] = {
+    "wood": Material(srgb_to_linear((0.62, 0.44, 0.27)), "parquet", 0.45, scale=1.0, variation=0.3,
+                     accent=srgb_to_linear((0.36, 0.23, 0.13)), bump=0.12),
+    "parquet": Material(srgb_to_linear((0.72, 0.54, 0.34)), "parquet", 0.4, scale=2.0, variation=0.35,
+                        accent=srgb_to_linear((0.45, 0.30, 0.17)), bump=0.12),
+    "tiles": Material(srgb_to_linear((0.88, 0.87, 0.84)), "tiles", 0.2, scale=3.333, variation=0.06,
+                      accent=srgb_to_linear((0.62, 0.6, 0.56)), bump=0.6),
+    "marble": Material(srgb_to_linear((0.9, 0.89, 0.86)), "marble", 0.15, scale=1.2, variation=0.3,
+                       accent=srgb_to_linear((0.45, 0.45, 0.47))),
+    "brick": Material(srgb_to_linear((0.66, 0.34, 0.24)), "brick", 0.85, scale=1.0, variation=0.25,
+                      accent=srgb_to_linear((0.78, 0.75, 0.7)), bump=0.8),
+    "fabric": Material(srgb_to_linear((0.62, 0.6, 0.66)), "fabric", 0.9, scale=200.0, variation=0.15,
+                       accent=srgb_to_linear((0.45, 0.43, 0.5)), bump=0.5),
+    "concrete": Material(srgb_to_linear((0.62, 0.61, 0.58)), "concrete", 0.8, scale=1.5, variation=0.2,
+                         accent=srgb_to_linear((0.48, 0.47, 0.45)), bump=0.3),
+    "carpet": Material(srgb_to_linear((0.55, 0.5, 0.44)), "carpet", 0.97, scale=400.0, variation=0.2,
+                       accent=srgb_to_linear((0.4, 0.36, 0.31)), bump=0.5),
+}
+
+
+NOISE_TEXELS = 64
+NOISE_LATTICES = (8, 16, 32, 64)            # lattice cells per tile of each channel (octave)
+NOISE_SEED = 20240611
+
+
+def noise_volume() -> np.ndarray:
+    """(N, N, N, 4) uint8 tiling value noise, one octave per channel: random lattice values
+    smoothly interpolated (smoothstep), periodic so the texture repeats without seams."""
+    rng = np.random.default_rng(NOISE_SEED)
+    n = NOISE_TEXELS
+    out = np.empty((n, n, n, 4), np.uint8)
+    for channel, cells in enumerate(NOISE_LATTICES):
+        lattice = rng.random((cells, cells, cells))
+        t = np.arange(n) * cells / n
+        i0 = np.floor(t).astype(int)
+        f = t - i0
+        f = f * f * (3 - 2 * f)
+        i1 = (i0 + 1) % cells
+        # separable periodic interpolation along z, y, x
+        v = lattice[i0] * (1 - f)[:, None, None] + lattice[i1] * f[:, None, None]
+        v = v[:, i0] * (1 - f)[None, :, None] + v[:, i1] * f[None, :, None]
+        v = v[:, :, i0] * (1 - f)[None, None, :] + v[:, :, i1] * f[None, None, :]
+        out[..., channel] = np.round(v * 255).astype(np.uint8)
+    return out
+
+
+class MaterialTable:
+    """Palette materials at fixed indices, then one slot per distinct (paint, surface) in use."""
+
+    def __init__(self) -> None:
+        self.materials: list[Material] = [palette_material(n, tuple(PALETTE.rgb[i]))
+                                          for i, n in enumerate(PALETTE.names)]
+        self._paint_slots: dict[tuple[str, str], int] = {}
+
+    def paint(self, paint: str, surface: str) -> int:
+        """Material index of a paint on a surface ('walls', 'floor' or 'ceiling')."""
+        key = (paint, surface)
+        if key not in self._paint_slots:
+            self._paint_slots[key] = len(self.materials)
+            self.materials.append(paint_material(paint, "floor" if surface == "floor" else "walls"))
+        return self._paint_slots[key]
+
+    def pack(self) -> np.ndarray:
+        """(len, TEXELS, 4) float32: [colour, pattern], [roughness, metalness, scale, variation],
+        [accent, bump]."""
+        rows = [[(*m.colour, PATTERN[m.pattern]), (m.roughness, m.metalness, m.scale, m.variation),
+                 (*m.accent, m.bump)] for m in self.materials]
+        return np.asarray(rows, np.float32)

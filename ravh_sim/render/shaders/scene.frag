@@ -1,0 +1,306 @@
+// Physically based shading of one surface point: procedural material, the sun with filtered
+// shadow-map look-ups, lamps with inverse-square fall-off and cube shadow maps, per-room sky and
+// bounce light with ambient occlusion, window glass that shows the outdoors, emissive fixtures.
+// Writes HDR colour (alpha: log luminance, for auto-exposure), z-depth in metres and the instance id.
+// Compiled once per pattern (PATTERN_ID): a CPU rasteriser runs every branch of a shader, so each
+// material group is drawn by a program that holds only its own pattern.
+in vec3 v_world;
+in vec3 v_normal;
+in vec3 v_local;
+in float v_eye_z;
+flat in int v_material;
+flat in int v_instance;
+layout(location = 0) out vec4 out_hdr;
+layout(location = 1) out float out_depth;
+layout(location = 2) out int out_instance;
+
+uniform sampler2D u_materials;        // TEXELS x materials
+uniform sampler2D u_instances;        // instances x 3: ambient+room, emission+kind, floor/ceiling z
+uniform sampler2DShadow u_sun_shadow;
+uniform sampler2D u_point_shadow;     // atlas: 6 faces per row, one row per shadowed lamp
+uniform sampler2D u_coverage;         // blurred top-down coverage (ambient occlusion on floors)
+uniform mat4 u_sun_matrix;
+uniform vec3 u_sun_irradiance;
+uniform vec4 u_coverage_box;          // x0, y0, 1/width, 1/height in metres
+uniform vec3 u_eye;
+uniform int u_light_count;
+uniform vec4 u_light_position[MAX_LIGHTS];   // xyz, range
+uniform vec4 u_light_power[MAX_LIGHTS];      // rgb, shadow row (-1: none; then confined to its room)
+uniform float u_light_room[MAX_LIGHTS];
+uniform mat4 u_face_matrix[6];
+uniform vec2 u_atlas_texels;                 // atlas size in texels
+uniform float u_tile;                        // texels per cube face
+uniform int u_shadows;                       // realistic quality: shadows on
+
+struct Surface { vec3 albedo; float roughness; float metalness; float height; };
+
+vec3 face_normal_local() {
+    return abs(normalize(cross(dFdx(v_local), dFdy(v_local))));
+}
+
+// Planar coordinates of a point on a face: the two axes the face spans.
+vec2 planar(vec3 p, vec3 n) {
+    return n.z > 0.7 ? p.xy : (n.x > n.y ? p.yz : p.xz);
+}
+
+Surface pattern(vec3 base, vec3 accent, float rough, float metal, float scale, float variation, vec3 p) {
+    vec3 n = face_normal_local();
+    vec2 uv = planar(p, n);
+    Surface s = Surface(base, rough, metal, 0.0);
+#if PATTERN_ID == PATTERN_WOOD
+    {
+        float along = n.z > 0.7 ? p.x : p.z;
+        float across = n.z > 0.7 ? p.y : (n.x > n.y ? p.y : p.x);
+        float warp = 2.0 * fbm(vec3(along * 1.2, across * 3.0, 0.0));
+        float ring = fract(across * scale + warp);
+        float streak = 0.6 * vnoise(vec3(along * 2.0, across * 18.0, 3.0)) + 0.4 * grain(vec3(along * 40.0, across * 400.0, 3.0));
+        float t = smoothstep(0.15, 0.85, ring) * 0.65 + 0.35 * streak;
+        s.albedo = mix(base, accent, t * variation * 2.0);
+        s.height = t;
+    }
+#elif PATTERN_ID == PATTERN_PARQUET
+    {
+        float width = 0.16 / scale, len = 1.2 / scale;
+        float row = floor(uv.y / width);
+        float shift = hash12(vec2(row, 7.0)) * len;
+        float col = floor((uv.x + shift) / len);
+        vec2 f = vec2(fract((uv.x + shift) / len) * len, fract(uv.y / width) * width);
+        float id = hash12(vec2(row, col));
+        float gap = min(min(f.x, len - f.x), min(f.y, width - f.y));
+        float groove = smoothstep(0.0008, 0.0025, gap);
+        float ring = fract((f.y + id) * 14.0 + 1.5 * fbm(vec3(f.x * 1.5, f.y * 6.0, id * 10.0)));
+        float streak = 0.6 * vnoise(vec3(f.x * 3.0, f.y * 25.0, id * 20.0)) + 0.4 * grain(vec3(f.x * 40.0, f.y * 500.0, id * 20.0));
+        float t = 0.6 * smoothstep(0.2, 0.9, ring) + 0.4 * streak;
+        s.albedo = mix(base, accent, t * variation * 1.6) * (0.82 + 0.36 * id) * mix(0.3, 1.0, groove);
+        s.roughness = mix(0.9, rough, groove);
+        s.height = groove + 0.15 * t;
+    }
+#elif PATTERN_ID == PATTERN_TILES
+    {
+        float size = 1.0 / scale;
+        vec2 c = uv / size;
+        vec2 f = fract(c) * size;
+        float gap = min(min(f.x, size - f.x), min(f.y, size - f.y));
+        float tile = smoothstep(0.0015, 0.0035, gap);
+        float id = hash12(floor(c) + 3.0);
+        s.albedo = mix(accent, base * (0.95 + 0.1 * id) * (0.97 + 0.06 * vnoise(p * 6.0)), tile);
+        s.roughness = mix(0.85, rough, tile);
+        s.height = tile;
+    }
+#elif PATTERN_ID == PATTERN_MARBLE
+    {
+        float v = abs(sin(dot(p, vec3(1.0, 0.6, 0.3)) * scale * 3.0 + 6.0 * fbm(p * scale)));
+        float vein = smoothstep(0.0, 0.15, v);
+        s.albedo = mix(accent, base, mix(1.0, vein, variation * 2.5)) * (0.96 + 0.08 * fbm(p * 9.0));
+        s.height = vein * 0.2;
+    }
+#elif PATTERN_ID == PATTERN_FABRIC
+    {
+        float weave = sin(uv.x * scale * PI) * sin(uv.y * scale * PI);
+        float t = 0.5 + 0.5 * weave;
+        float mottle = fbm(p * 7.0);
+        s.albedo = mix(accent, base, 0.7 + 0.3 * t) * (1.0 + (mottle - 0.5) * variation);
+        s.height = t * 0.5 + 0.5 * grain(p * scale * 0.25);
+    }
+#elif PATTERN_ID == PATTERN_LEATHER
+    {
+        float cell = vnoise(p * scale * 0.15);
+        float crease = 1.0 - abs(cell * 2.0 - 1.0);
+        s.albedo = base * (0.88 + 0.24 * fbm(p * 4.0)) * (1.0 - 0.15 * crease * variation * 4.0);
+        s.roughness = rough + 0.15 * crease;
+        s.height = crease;
+    }
+#elif PATTERN_ID == PATTERN_CARPET
+    {
+        float pile = grain(p * scale) * 0.5 + vnoise(p * 12.0) * 0.5;
+        s.albedo = mix(accent, base, pile) * (0.9 + 0.2 * fbm(p * 1.5));
+        s.height = pile;
+    }
+#elif PATTERN_ID == PATTERN_BRICK
+    {
+        vec2 b = vec2(uv.x, uv.y) / vec2(0.24, 0.075);
+        float row = floor(b.y);
+        b.x += 0.5 * mod(row, 2.0);
+        vec2 f = fract(b) * vec2(0.24, 0.075);
+        float gap = min(min(f.x, 0.24 - f.x), min(f.y, 0.075 - f.y));
+        float brick = smoothstep(0.004, 0.007, gap);
+        float id = hash12(floor(b) + 11.0);
+        s.albedo = mix(accent, base * (0.8 + 0.4 * id) * (0.9 + 0.2 * grain(p * 120.0)), brick);
+        s.height = brick;
+    }
+#elif PATTERN_ID == PATTERN_CONCRETE
+    {
+        float f = fbm(p * scale);
+        float speck = step(0.93, grain(p * 300.0));
+        s.albedo = mix(accent, base, f) * (1.0 - 0.2 * speck);
+        s.height = 0.3 * f + 0.2 * grain(p * 200.0);
+    }
+#elif PATTERN_ID == PATTERN_PLASTER
+    {
+        s.albedo = base * (1.0 + (fbm(p * scale) - 0.5) * variation * 2.0);
+        s.height = 0.4 * grain(p * 300.0) + 0.6 * vnoise(p * 14.0);
+    }
+#elif PATTERN_ID == PATTERN_METAL
+    {
+        float brushed = grain(vec3(uv.x * 3.0, uv.y * scale, 0.0));
+        s.albedo = base * (0.92 + 0.16 * brushed);
+        s.roughness = rough * (0.8 + 0.4 * brushed);
+        s.height = brushed * 0.3;
+    }
+#elif PATTERN_ID == PATTERN_FOLIAGE
+    {
+        float f = fbm(p * scale);
+        s.albedo = mix(accent, base, f) * (0.8 + 0.4 * grain(p * scale * 3.0));
+        s.height = f;
+    }
+#else
+    {
+        float f = fbm(p * scale);
+        s.albedo = base * (1.0 + (f - 0.5) * variation);
+        s.height = f * 0.2;
+    }
+#endif
+    return s;
+}
+
+// Normal detail from a height field without tangents (Mikkelsen's surface gradient).
+vec3 bumped(vec3 n, vec3 p, float height, float strength) {
+    vec3 dpdx = dFdx(p), dpdy = dFdy(p);
+    float dhdx = dFdx(height), dhdy = dFdy(height);
+    vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
+    float det = dot(dpdx, r1);
+    if (abs(det) < 1e-12) return n;
+    vec3 grad = (dhdx * r1 + dhdy * r2) / det;
+    return normalize(n - strength * 0.01 * grad);
+}
+
+float ggx(float n_h, float a) {
+    float a2 = a * a;
+    float d = n_h * n_h * (a2 - 1.0) + 1.0;
+    return a2 / (PI * d * d);
+}
+
+vec3 brdf(vec3 n, vec3 v, vec3 l, vec3 albedo, float roughness, float metalness) {
+    vec3 h = normalize(v + l);
+    float n_v = max(dot(n, v), 1e-3), n_l = max(dot(n, l), 1e-3), n_h = max(dot(n, h), 0.0);
+    float a = max(roughness * roughness, 2e-3);
+    float k = a * 0.5;
+    float visibility = 0.25 / ((n_v * (1.0 - k) + k) * (n_l * (1.0 - k) + k));
+    vec3 f0 = mix(vec3(0.04), albedo, metalness);
+    vec3 fresnel = f0 + (1.0 - f0) * pow(1.0 - max(dot(v, h), 0.0), 5.0);
+    vec3 diffuse = (1.0 - fresnel) * (1.0 - metalness) * albedo / PI;
+    return diffuse + ggx(n_h, a) * visibility * fresnel;
+}
+
+float sun_shadow(vec3 p, vec3 n) {
+    vec4 c = u_sun_matrix * vec4(p + n * 0.015, 1.0);
+    vec3 s = c.xyz / c.w;
+    if (any(lessThan(s.xy, vec2(0.0))) || any(greaterThan(s.xy, vec2(1.0)))) return 1.0;
+    vec2 texel = 1.0 / vec2(textureSize(u_sun_shadow, 0));
+    float lit = 0.0;
+    lit += texture(u_sun_shadow, vec3(s.xy + vec2(-1.2, -0.4) * texel, s.z - 0.0008));
+    lit += texture(u_sun_shadow, vec3(s.xy + vec2(0.4, -1.2) * texel, s.z - 0.0008));
+    lit += texture(u_sun_shadow, vec3(s.xy + vec2(1.2, 0.4) * texel, s.z - 0.0008));
+    lit += texture(u_sun_shadow, vec3(s.xy + vec2(-0.4, 1.2) * texel, s.z - 0.0008));
+    return lit * 0.25;
+}
+
+float lamp_shadow(float row, vec3 d, vec3 n) {
+    vec3 a = abs(d);
+    int face = (a.x >= a.y && a.x >= a.z) ? (d.x > 0.0 ? 0 : 1) : (a.y >= a.z ? (d.y > 0.0 ? 2 : 3) : (d.z > 0.0 ? 4 : 5));
+    vec4 c = u_face_matrix[face] * vec4(d, 1.0);
+    vec2 uv = clamp(c.xy / c.w * 0.5 + 0.5, 1.5 / u_tile, 1.0 - 1.5 / u_tile);
+    vec2 texel = (vec2(float(face), row) + uv) * u_tile;
+    float reach = length(d) - 0.02 - 0.01 * length(d);
+    float lit = 0.0;
+    lit += step(reach, texture(u_point_shadow, (texel + vec2(-0.7, -0.3)) / u_atlas_texels).r);
+    lit += step(reach, texture(u_point_shadow, (texel + vec2(0.3, -0.7)) / u_atlas_texels).r);
+    lit += step(reach, texture(u_point_shadow, (texel + vec2(0.7, 0.3)) / u_atlas_texels).r);
+    lit += step(reach, texture(u_point_shadow, (texel + vec2(-0.3, 0.7)) / u_atlas_texels).r);
+    return lit * 0.25;
+}
+
+void main() {
+    vec4 m0 = texelFetch(u_materials, ivec2(0, v_material), 0);
+    vec4 m1 = texelFetch(u_materials, ivec2(1, v_material), 0);
+    vec4 m2 = texelFetch(u_materials, ivec2(2, v_material), 0);
+    vec4 ambient_room = texelFetch(u_instances, ivec2(v_instance, 0), 0);
+    vec4 emission_kind = texelFetch(u_instances, ivec2(v_instance, 1), 0);
+    vec4 levels = texelFetch(u_instances, ivec2(v_instance, 2), 0);
+    int kind = int(emission_kind.a + 0.5);
+
+    vec3 v = normalize(u_eye - v_world);
+    vec3 n = normalize(v_normal);
+    if (dot(n, v) < 0.0) n = -n;                       // thin parts are seen from both sides
+    vec3 seeded = v_local + (kind >= KIND_OBJECT ? hash12(vec2(float(v_instance), 1.0)) * 37.0 : 0.0);
+    Surface s = pattern(m0.rgb, m2.rgb, m1.x, m1.y, m1.z, m1.w, seeded);
+    n = bumped(n, v_world, s.height, m2.a);
+
+    vec3 colour;
+#if PATTERN_ID == PATTERN_GLASS
+    {
+        // Window glass: the outdoors through it, the room faintly reflected.
+        vec3 through = outdoor(-v);
+        float fresnel = 0.04 + 0.96 * pow(1.0 - max(dot(n, v), 0.0), 5.0);
+        colour = mix(through * vec3(0.92, 0.96, 0.95), ambient_room.rgb * 0.5, fresnel);
+    }
+#else
+    {
+        float above_floor = v_world.z - levels.x;
+        float occlusion = 1.0;
+        vec2 cover_uv = (v_world.xy - u_coverage_box.xy) * u_coverage_box.zw;
+        float cover = texture(u_coverage, cover_uv).r;
+        if (kind == KIND_FLOOR) {
+            occlusion = 1.0 - 0.6 * cover;
+        } else if (kind == KIND_WALLS) {
+            occlusion = (1.0 - 0.3 * exp(-above_floor / 0.2)) * (1.0 - 0.25 * exp(-(levels.y - v_world.z) / 0.25));
+        } else if (kind != KIND_CEILING) {
+            occlusion = mix(0.55, 1.0, smoothstep(0.0, 0.45, above_floor)) * (1.0 - 0.3 * cover * exp(-above_floor / 0.3));
+        }
+        vec3 diffuse_albedo = s.albedo * (1.0 - s.metalness);
+        vec3 f0 = mix(vec3(0.04), s.albedo, s.metalness);
+        // Sky and bounce light of the room; glossy and metal surfaces reflect a bright-above,
+        // dark-below surround of the same colour.
+        vec3 r = reflect(-v, n);
+        float surround = mix(0.35, 1.4, clamp(r.z * 0.5 + 0.5, 0.0, 1.0));
+        vec3 env_f = f0 + (1.0 - f0) * pow(1.0 - max(dot(n, v), 0.0), 5.0) * (1.0 - s.roughness);
+        colour = ambient_room.rgb * occlusion * (diffuse_albedo + env_f * surround * (1.0 - 0.7 * s.roughness));
+#if PATTERN_ID == PATTERN_MIRROR || PATTERN_ID == PATTERN_SCREEN
+        float band = smoothstep(-0.05, 0.05, r.z);
+        vec3 room_seen = ambient_room.rgb * mix(vec3(0.55, 0.5, 0.45), vec3(1.3), band) * (0.8 + 0.4 * fbm(r * 3.0));
+        colour = PATTERN_ID == PATTERN_MIRROR ? room_seen * 0.9 : colour + room_seen * 0.08;
+#endif
+        // The sun.
+        float n_l = dot(n, u_sun_dir);
+        if (n_l > 0.0 && dot(u_sun_irradiance, vec3(1.0)) > 1e-4) {
+            float lit = u_shadows == 1 ? sun_shadow(v_world, normalize(v_normal)) : 1.0;
+            colour += brdf(n, v, u_sun_dir, s.albedo, s.roughness, s.metalness) * u_sun_irradiance * n_l * lit;
+        }
+        // Lamps and ceiling lights, branch-free (a CPU rasteriser pays for divergent branches):
+        // Lambert plus a normalised Blinn-Phong lobe matched to the roughness.
+        float shininess = 2.0 / max(s.roughness * s.roughness * s.roughness * s.roughness, 1e-3);
+        float lobe = (shininess + 8.0) / (8.0 * PI);
+        vec3 lamp_diffuse = diffuse_albedo / PI;
+        for (int i = 0; i < u_light_count; ++i) {
+            vec3 d = v_world - u_light_position[i].xyz;
+            float dist2 = dot(d, d);
+            float range2 = u_light_position[i].w * u_light_position[i].w;
+            vec3 l = -d * inversesqrt(dist2);
+            float n_l_lamp = max(dot(n, l), 0.0);
+            float window = clamp(1.0 - dist2 * dist2 / (range2 * range2), 0.0, 1.0);
+            float row = u_light_power[i].w;
+            float here = row >= 0.0 ? 1.0 : step(abs(u_light_room[i] - ambient_room.a), 0.5);
+            float lit = (row >= 0.0 && u_shadows == 1 && n_l_lamp > 0.0) ? lamp_shadow(row, d, n) : 1.0;
+            float n_h = max(dot(n, normalize(v + l)), 0.0);
+            vec3 irradiance = u_light_power[i].rgb * (window * window * here * lit * n_l_lamp / (dist2 + 0.04));
+            colour += irradiance * (lamp_diffuse + f0 * lobe * pow(n_h, shininess));
+        }
+#if PATTERN_ID == PATTERN_EMISSIVE
+        colour += emission_kind.rgb * s.albedo;
+#endif
+    }
+#endif
+    out_hdr = vec4(colour, log(luminance(colour) + 1e-4));
+    out_depth = v_eye_z;
+    out_instance = v_instance;
+}
