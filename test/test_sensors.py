@@ -331,18 +331,22 @@ def test_day_is_brighter_than_sunset_is_brighter_than_night(camera, appearance):
     assert sun_light(200).gain[2] > sun_light(200).gain[0]          # night is blue
 
 
-def test_lights_on_brighten_their_room_at_night_and_not_the_other(camera, world, appearance):
+def test_lights_on_brighten_their_room_at_night_and_not_through_the_wall(world, appearance):
+    """With the exposure fixed (a camera in manual mode), a lamp brightens its own room and leaves
+    the far side of the wall, seen from the next room with the door shut, exactly as it was."""
+    camera = SmartCamera(world, PROFILE.camera, CameraOptions(manual_exposure=4.0))
     appearance.set_sun("night")
     appearance.set_lights("all", "off")
-    pose = (3.0, 1.5, 0.0)                            # room A, looking through the door into room B
-    dark = camera.capture(*pose)
+    appearance.set_door("Door_0", False)
+    in_a, in_b = (3.0, 1.5, 0.0), (7.5, 3.3, math.pi)       # B looks west, at the wall it shares with A
+    dark_a, dark_b = camera.capture(*in_a), camera.capture(*in_b)
     appearance.set_light("Light_0", True)
-    lit = camera.capture(*pose)
-    room_a = np.isin(dark.instance, list({i.id for i in world.instances if i.room == "A"}))
-    room_b = np.isin(dark.instance, list({i.id for i in world.instances if i.room == "B"}))
-    assert room_a.mean() > 0.5 and room_b.mean() > 0.01
-    assert _mean(lit.rgb, room_a) > 3 * _mean(dark.rgb, room_a)
-    assert np.array_equal(lit.rgb[room_b], dark.rgb[room_b])          # no light through the wall
+    lit_a, lit_b = camera.capture(*in_a), camera.capture(*in_b)
+    room_a = np.isin(dark_a.instance, list({i.id for i in world.instances if i.room == "A"}))
+    wall_b = dark_b.instance == world.instance("B/walls").id
+    assert room_a.mean() > 0.5 and wall_b.mean() > 0.3
+    assert _mean(lit_a.rgb, room_a) > 3 * _mean(dark_a.rgb, room_a)
+    assert np.array_equal(lit_b.rgb, dark_b.rgb)                      # no light through the wall
 
 
 def test_paint_changes_wall_pixel_colour(camera, world, appearance):
@@ -394,16 +398,21 @@ def test_randomise_changes_settings_and_world_together(world, appearance):
     assert fp["settings"]["paint"] == target.paint
 
 
-def test_window_shows_the_sky(camera, world, appearance):
+def test_window_is_an_opening_onto_the_outdoors(world, appearance):
+    """The wall is cut where the window is: its glass (labelled with the window) shows a bright
+    outdoors by day and a dark one at night, and depth stops at the glass."""
+    camera = SmartCamera(world, PROFILE.camera, CameraOptions(manual_exposure=1.0))
     window = world.instance("Wall_0").id
+    seen = {}
     for preset in ("day", "night"):
         appearance.set_sun(preset)
         cap = camera.capture(3.0, 2.0, math.pi)
         pane = cap.instance == window
         assert pane.mean() > 0.03
-        sky = np.array(sun_light(world.settings.sun_angle).sky)
-        assert (np.abs(cap.rgb[pane].astype(int) - sky).max(axis=1) == 0).mean() > 0.6
-        assert np.isfinite(cap.depth[pane]).all()          # the glass is in the wall: depth stays
+        assert np.isfinite(cap.depth[pane]).all()
+        seen[preset] = _mean(cap.rgb, pane)
+    assert seen["day"] > 90                                  # a bright outdoors by day
+    assert seen["night"] < seen["day"] / 3
 
 
 # ----------------------------------------------------------------------------- determinism, renderers
@@ -425,16 +434,17 @@ def test_same_seed_and_pose_give_identical_images_and_scans(box_house):
     assert not np.array_equal(a1.rgb, c1.rgb) and not np.array_equal(s1.ranges, u1.ranges)   # new seed
 
 
-def test_tiny_renderer_fallback_gives_a_similar_image(box_house, camera):
+def test_tiny_renderer_fallback_sees_the_same_geometry(box_house, camera):
+    """The fallback looks plainer (no shadows, no materials) but sees the same scene from the same K."""
     pose = (3.0, 1.5, 0.3)
-    egl = camera.capture(*pose)
+    gl = camera.capture(*pose)
     with _world(box_house, "tiny") as w:
         assert w.renderer == "tiny"
         tiny = SmartCamera(w, PROFILE.camera).capture(*pose)
-    assert (egl.instance == tiny.instance).mean() > 0.99
-    both = np.isfinite(egl.depth) & np.isfinite(tiny.depth)
-    assert np.median(np.abs(egl.depth[both] - tiny.depth[both])) < 0.01
-    assert abs(_mean(egl.rgb) - _mean(tiny.rgb)) < 15
+    assert (gl.instance == tiny.instance).mean() > 0.99
+    both = np.isfinite(gl.depth) & np.isfinite(tiny.depth)
+    assert np.median(np.abs(gl.depth[both] - tiny.depth[both])) < 0.01
+    assert tiny.rgb.std() > 10 and gl.rgb.std() > 10
 
 
 # ----------------------------------------------------------------------------- optics

@@ -29,6 +29,7 @@ from ravh_sim.render.projection import look_at, orthographic, perspective, proje
 from ravh_sim.world.appearance import SunLight, sun_light
 from ravh_sim.world.house import Light
 from ravh_sim.world.scene import World
+from ravh_sim.world.topology import room_index_raster, room_links
 
 KINDS = {"floor": 0, "ceiling": 1, "walls": 2, "object": 3, "door": 4, "window": 5}
 MAX_LIGHTS = 32                       # switched-on lights with a shadow map
@@ -37,17 +38,19 @@ FRAME_LIGHT_REACH = 9.0               # m: lights farther from the camera are le
 SUN_SHADOW_TEXELS = 2048
 LAMP_TILE = 192                       # texels per cube face of a lamp's shadow map
 COVERAGE_TEXELS = 512
+ROOM_MAP_RESOLUTION = 0.05            # m per cell of the floor-plan room map
 COVERAGE_BLUR_M = 0.12                # sigma of the floor occlusion blur
 
 SUN_IRRADIANCE = 9.0                  # noon sun on a surface facing it
 SKY_AMBIENT = 0.55                    # sky light of a room with generous windows, by day
 MIN_OPENNESS = 0.25                   # rooms without windows still get light through their doors
 WINDOW_REACH = 6.0                    # window area x this / floor area = fully open room
-LAMP_POWER = 2.2                      # irradiance of an intensity-1 lamp at 1 m
+LAMP_POWER = 1.0                      # irradiance of an intensity-1 lamp at 1 m
 AMBIENT_TINT = 0.35                   # share of the daylight colour that survives bouncing indoors
 LAMP_BOUNCE = 0.35                    # share of a lamp's power that comes back as room ambient (/m^2)
 FIXTURE_GLOW = 6.0                    # radiance of a switched-on lamp shade or bulb
-NIGHT_FLOOR = 0.004                   # ambient that never goes away (moon, street lights)
+MOONLIGHT = 0.12                      # the moon and night sky, as a share of sun_light's night gain
+NIGHT_FLOOR = 0.002                  # ambient that never goes away (moon, street lights)
 EXPOSURE_KEY = 0.2                    # mid-grey target of auto-exposure
 EXPOSURE_REFERENCE = 0.5              # log-average luminance of a daylit room
 EXPOSURE_ADAPTATION = 0.5             # how much of a brightness change exposure undoes (1 = all)
@@ -140,6 +143,14 @@ class GLRenderer:
 
         self.atlas = None
         self.atlas_fbo = None
+        self.instance_texture = None
+        self.room_light = None
+        labels, origin = room_index_raster(world.house, ROOM_MAP_RESOLUTION)
+        self.room_map = self._nearest_texture((labels.shape[1], labels.shape[0]), labels.astype(np.float32), 1)
+        self.room_map.repeat_x = self.room_map.repeat_y = False
+        height_m, width_m = np.asarray(labels.shape) * ROOM_MAP_RESOLUTION
+        self._room_box = (origin[0] - ROOM_MAP_RESOLUTION / 2, origin[1] - ROOM_MAP_RESOLUTION / 2,
+                          1.0 / width_m, 1.0 / height_m)
         self.vbo = None
         self.vaos: dict[str, object] = {}
         self._geometry_revision = -1
@@ -152,7 +163,8 @@ class GLRenderer:
         for obj in (*self.scene_programs.values(), self.depth_program, self.sky_program, self.tonemap_program, self.shadow_program,
                     self.coverage_program, self.meter_program, self.meter, self.meter_fbo, self.hdr, self.depth, self.instance, self.main_fbo, self.ldr,
                     self.ldr_fbo, self.sun_depth, self.sun_fbo, self.coverage_raw, self.coverage_fbo,
-                    self.coverage, self.noise, self.atlas, self.atlas_fbo, self.vbo, *self.vaos.values()):
+                    self.coverage, self.noise, self.room_map, self.room_light, self.instance_texture,
+                    self.atlas, self.atlas_fbo, self.vbo, *self.vaos.values()):
             if obj is not None:
                 obj.release()
 
@@ -207,23 +219,29 @@ class GLRenderer:
         self.material_texture.filter = (self.ctx.NEAREST, self.ctx.NEAREST)
 
     def _upload_instances(self, sun: SunLight, lights: list[Light]) -> None:
-        """Per instance: the room's ambient light and index, a fixture's glow and the kind, the
-        room's floor and ceiling heights."""
+        """Per instance: its room, a fixture's glow and the kind, the room's floor and ceiling
+        heights; per room: its sky and bounce light."""
         house, world = self.world.house, self.world
         rooms = {room.id: i for i, room in enumerate(house.rooms)}
-        ambient = {room.id: self._room_ambient(room, sun, lights) for room in house.rooms}
         glow = {lt.id: np.asarray(lt.color) * FIXTURE_GLOW * max(lt.intensity, 0.3) for lt in lights}
         size = max(inst.id for inst in world.instances) + 1
         data = np.zeros((3, size, 4), np.float32)
         for inst in world.instances:
             room = house.room(inst.room)
-            data[0, inst.id] = (*ambient[inst.room], rooms[inst.room])
+            data[0, inst.id, 3] = rooms[inst.room]
             data[1, inst.id] = (*glow.get(inst.name, (0.0, 0.0, 0.0)), KINDS[inst.kind])
             data[2, inst.id, :2] = (room.floor_z, room.ceiling_z)
-        if getattr(self, "instance_texture", None) is not None:
-            self.instance_texture.release()
-        self.instance_texture = self.ctx.texture((size, 3), 4, data.tobytes(), dtype="f4")
-        self.instance_texture.filter = (self.ctx.NEAREST, self.ctx.NEAREST)
+        ambient = np.array([[*self._room_ambient(room, sun, lights), 0.0] for room in house.rooms], np.float32)
+        for old in (self.instance_texture, self.room_light):
+            if old is not None:
+                old.release()
+        self.instance_texture = self._nearest_texture((size, 3), data)
+        self.room_light = self._nearest_texture((len(house.rooms), 1), ambient)
+
+    def _nearest_texture(self, size: tuple[int, int], data: np.ndarray, components: int = 4):
+        texture = self.ctx.texture(size, components, np.ascontiguousarray(data, np.float32).tobytes(), dtype="f4")
+        texture.filter = (self.ctx.NEAREST, self.ctx.NEAREST)
+        return texture
 
     def _room_ambient(self, room, sun: SunLight, lights: list[Light]) -> np.ndarray:
         """Sky light through the room's windows plus the bounce of its own lamps. Indoors, light
@@ -232,7 +250,7 @@ class GLRenderer:
         house = self.world.house
         window_area = sum(w.width * w.height for w in house.windows if w.room == room.id)
         openness = max(MIN_OPENNESS, min(1.0, WINDOW_REACH * window_area / max(room.area, 1.0)))
-        gain = np.asarray(sun.gain)
+        gain = np.asarray(sun.gain) * (1.0 if sun.angle <= 180.0 else MOONLIGHT)
         level = float(gain.mean())
         tint = level * (1.0 - AMBIENT_TINT) + gain * AMBIENT_TINT
         bounce = sum((np.asarray(lt.color) * lt.intensity for lt in lights if lt.room == room.id), np.zeros(3))
@@ -242,16 +260,17 @@ class GLRenderer:
     def _set_lighting(self, sun: SunLight, lights: list[Light]) -> None:
         direction = np.asarray(sun.direction)
         elevation = math.degrees(math.asin(max(-1.0, min(1.0, direction[2]))))
-        sun_up = min(1.0, max(0.0, elevation / 2.0 + 0.5)) if sun.angle <= 180.0 else 0.25
+        sun_up = min(1.0, max(0.0, elevation / 2.0 + 0.5)) if sun.angle <= 180.0 else MOONLIGHT
         irradiance = SUN_IRRADIANCE * np.asarray(sun.gain) * sun_up
-        sky = np.asarray(srgb_to_linear(tuple(c / 255 for c in sun.sky)))
-        level = float(np.mean(sun.gain))
+        outside = 1.0 if sun.angle <= 180.0 else 3 * MOONLIGHT
+        sky = np.asarray(srgb_to_linear(tuple(c / 255 for c in sun.sky))) * outside
+        level = float(np.mean(sun.gain)) * outside
         uniforms = {
             "u_sun_dir": tuple(direction), "u_sun_irradiance": tuple(irradiance),
             "u_sun_radiance": tuple(irradiance * 4.0),
-            "u_sky_zenith": tuple(sky * 1.6), "u_sky_horizon": tuple(sky * 0.8 + 0.6 * np.asarray(sun.gain)),
-            "u_ground": tuple(np.array([0.16, 0.2, 0.1]) * level * 1.4),
-            "u_facade": tuple(np.array([0.55, 0.5, 0.45]) * np.asarray(sun.gain) * 1.3),
+            "u_sky_zenith": tuple(sky * 1.6), "u_sky_horizon": tuple(sky * 0.8 + 0.6 * np.asarray(sun.gain) * outside),
+            "u_ground": tuple(np.array([0.09, 0.16, 0.05]) * level * 1.6),
+            "u_facade": tuple(np.array([0.55, 0.5, 0.45]) * np.asarray(sun.gain) * 1.3 * outside),
         }
         for name, value in uniforms.items():
             self._set(name, value, also=(self.sky_program,))
@@ -271,20 +290,32 @@ class GLRenderer:
         """The lamps that can light this view: the nearest FRAME_LIGHTS switched-on ones within
         FRAME_LIGHT_REACH (a CPU rasteriser pays for every light on every pixel)."""
         index = {room.id: i for i, room in enumerate(self.world.house.rooms)}
+        assert len(index) <= 32, "a light's room mask holds 32 rooms"
         near = sorted((float(np.linalg.norm(np.asarray(lt.position) - position)), row, lt)
                       for row, lt in enumerate(self._lights))
         chosen = [(row, lt) for d, row, lt in near if d < FRAME_LIGHT_REACH][:FRAME_LIGHTS]
         positions = np.zeros((MAX_LIGHTS, 4), np.float32)
         powers = np.zeros((MAX_LIGHTS, 4), np.float32)
-        rooms = np.zeros(MAX_LIGHTS, np.float32)
+        reach = np.zeros(MAX_LIGHTS, np.int32)
         for i, (row, lt) in enumerate(chosen):
             positions[i] = (*lt.position, lt.range)
             powers[i] = (*(np.asarray(lt.color) * lt.intensity * LAMP_POWER), row if self.shadows else -1)
-            rooms[i] = index[lt.room]
+            reach[i] = sum(1 << index[room] for room in self._lit_rooms(lt.room))
         self._set("u_light_count", len(chosen))
         self._set("u_light_position", positions.tobytes())
         self._set("u_light_power", powers.tobytes())
-        self._set("u_light_room", rooms.tobytes())
+        self._set("u_light_rooms", reach.tobytes())
+
+    def _lit_rooms(self, room: str) -> set[str]:
+        """The rooms a light in ``room`` can reach: its own and (with shadows, which keep the light
+        to what it can see) those joined to it by an open door or an archway."""
+        rooms = {room}
+        if self.shadows:
+            doors = self.world.settings.doors
+            for link in room_links(self.world.house):
+                if room in link.rooms and (link.door is None or doors.get(link.door, True)):
+                    rooms.update(link.rooms)
+        return rooms
 
     # ------------------------------------------------------------------ precomputed light
     def _render_sun_shadow(self, sun: SunLight) -> None:
@@ -374,9 +405,10 @@ class GLRenderer:
         adapted = EXPOSURE_REFERENCE * (average / EXPOSURE_REFERENCE) ** EXPOSURE_ADAPTATION
         return float(np.clip(EXPOSURE_KEY / adapted, *EXPOSURE_RANGE))
 
-    def render(self, position: np.ndarray, rotation: np.ndarray) -> RenderedViews:
+    def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None
+               ) -> RenderedViews:
         """RGB, depth and instance images from an optical frame (rotation columns: x right, y down,
-        z forward) in the house frame."""
+        z forward) in the house frame; ``exposure`` fixes the exposure (None: auto-exposure)."""
         self._sync()
         ctx = self.ctx
         view = view_matrix(position, rotation)
@@ -392,9 +424,13 @@ class GLRenderer:
         (self.atlas if self.atlas is not None else self.depth).use(3)
         self.coverage.use(4)
         self.noise.use(5)
+        self.room_map.use(6)
+        self.room_light.use(7)
         for name, unit in (("u_materials", 0), ("u_instances", 1), ("u_sun_shadow", 2),
-                           ("u_point_shadow", 3), ("u_coverage", 4), ("u_noise", 5)):
+                           ("u_point_shadow", 3), ("u_coverage", 4), ("u_noise", 5), ("u_room_map", 6),
+                           ("u_room_light", 7)):
             self._set(name, unit, also=(self.sky_program,))
+        self._set("u_room_box", self._room_box)
         self.main_fbo.use()
         self.main_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         ctx.enable(ctx.DEPTH_TEST)
@@ -418,7 +454,7 @@ class GLRenderer:
         self.meter_vao.render(vertices=3)
         self.ldr_fbo.use()
         self.tonemap_program["u_hdr"].value = 0
-        self.tonemap_program["u_exposure"].value = self._exposure()
+        self.tonemap_program["u_exposure"].value = self._exposure() if exposure is None else exposure
         self.tonemap_vao.render(vertices=3)
         h, w = self.height, self.width
         rgb = np.frombuffer(self.ldr_fbo.read(components=3), np.uint8).reshape(h, w, 3)[::-1]

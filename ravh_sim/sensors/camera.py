@@ -50,6 +50,7 @@ class CameraOptions:
     motion_blur: bool = False
     exposure: float = 0.02                 # s, for motion blur
     depth_noise: float = 0.0               # sigma = depth_noise * z^2 (1/m)
+    manual_exposure: float | None = None   # GL renderer: a fixed exposure instead of auto-exposure
 
 
 @dataclass(frozen=True)
@@ -149,7 +150,7 @@ class SmartCamera:
         """The render from robot pose (x, y, yaw), before effects."""
         position, rotation = self.optical_pose(x, y, yaw, floor_z)
         if self.gl is not None:
-            views = self.gl.render(position, rotation)
+            views = self.gl.render(position, rotation, self.options.manual_exposure)
             return Frame(views.rgb, views.depth, views.instance, views.background, position, rotation)
         rgb, depth, instance, background = self._render(position, rotation,
                                                          sun_light(self.world.settings.sun_angle).direction)

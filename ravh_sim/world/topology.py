@@ -53,20 +53,30 @@ def room_links(house: House) -> tuple[Link, ...]:
     return tuple(sorted(links, key=lambda lk: (lk.rooms, lk.door or "", lk.position)))
 
 
-def _room_raster(house: House) -> tuple[np.ndarray, tuple[float, float]]:
-    """Room index + 1 per cell (0 outside, -1 wall)."""
+def room_index_raster(house: House, resolution: float = RESOLUTION) -> tuple[np.ndarray, tuple[float, float]]:
+    """Room index + 1 per cell of the house's floor plan (0 outside every room); rows run along y.
+    Returns the raster and the house-frame position of cell (0, 0)."""
     xmin, ymin, xmax, ymax = house.bounds
     origin = (xmin - 0.5, ymin - 0.5)
-    shape = (int((ymax - ymin + 1) / RESOLUTION) + 1, int((xmax - xmin + 1) / RESOLUTION) + 1)
+    shape = (int((ymax - ymin + 1) / resolution) + 1, int((xmax - xmin + 1) / resolution) + 1)
     labels = np.zeros(shape, np.int32)
-
-    def px(points) -> np.ndarray:
-        p = (np.asarray(points, float) - origin) / RESOLUTION
-        return np.round(p).astype(np.int32)
-
     for i, room in enumerate(house.rooms):
         for poly in (room.floor, *room.extra_floors):
-            cv2.fillPoly(labels, [px(poly)], i + 1)
+            cv2.fillPoly(labels, [_cells(poly, origin, resolution)], i + 1)
+    return labels, origin
+
+
+def _cells(points, origin: tuple[float, float], resolution: float) -> np.ndarray:
+    return np.round((np.asarray(points, float) - origin) / resolution).astype(np.int32)
+
+
+def _room_raster(house: House) -> tuple[np.ndarray, tuple[float, float]]:
+    """Room index + 1 per cell (0 outside, -1 wall)."""
+    labels, origin = room_index_raster(house)
+
+    def px(points) -> np.ndarray:
+        return _cells(points, origin, RESOLUTION)
+
     for wall in house.walls:
         if wall.z0 - house.room(wall.room).floor_z < WALL_BELOW_M:
             thickness = max(int(round(wall.thickness / RESOLUTION)), 1)

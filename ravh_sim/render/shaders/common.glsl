@@ -68,8 +68,10 @@ vec3 outdoor(vec3 d) {
     // Ground: grass and paths fading to haze in the distance.
     vec2 at = d.xy / max(-d.z, 0.02) * 1.5;
     float grass = 0.75 + 0.5 * fbm(vec3(at * 2.0, 4.0));
-    float haze = exp(elevation * 12.0);
-    return mix(u_ground * grass, u_sky_horizon * 0.8, haze * 0.6);
+    float haze = exp(elevation * 25.0);
+    float path = smoothstep(0.45, 0.5, vnoise(vec3(at * 0.3, 9.0)));
+    vec3 ground = mix(u_ground * grass, u_facade * 0.45, path * 0.35);
+    return mix(ground, u_sky_horizon * 0.7, haze * 0.35);
 }
 
 float luminance(vec3 c) {

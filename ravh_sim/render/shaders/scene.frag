@@ -15,7 +15,10 @@ layout(location = 1) out float out_depth;
 layout(location = 2) out int out_instance;
 
 uniform sampler2D u_materials;        // TEXELS x materials
-uniform sampler2D u_instances;        // instances x 3: ambient+room, emission+kind, floor/ceiling z
+uniform sampler2D u_instances;        // instances x 3: room, emission+kind, floor/ceiling z
+uniform sampler2D u_room_map;         // floor plan: room index + 1 per cell, 0 outside
+uniform vec4 u_room_box;              // x0, y0, 1/width, 1/height in metres
+uniform sampler2D u_room_light;       // rooms x 1: sky and bounce light of each room
 uniform sampler2DShadow u_sun_shadow;
 uniform sampler2D u_point_shadow;     // atlas: 6 faces per row, one row per shadowed lamp
 uniform sampler2D u_coverage;         // blurred top-down coverage (ambient occlusion on floors)
@@ -26,7 +29,7 @@ uniform vec3 u_eye;
 uniform int u_light_count;
 uniform vec4 u_light_position[MAX_LIGHTS];   // xyz, range
 uniform vec4 u_light_power[MAX_LIGHTS];      // rgb, shadow row (-1: none; then confined to its room)
-uniform float u_light_room[MAX_LIGHTS];
+uniform int u_light_rooms[MAX_LIGHTS];       // bit r: the light reaches room r (its own, open doors)
 uniform mat4 u_face_matrix[6];
 uniform vec2 u_atlas_texels;                 // atlas size in texels
 uniform float u_tile;                        // texels per cube face
@@ -205,13 +208,13 @@ float sun_shadow(vec3 p, vec3 n) {
     return lit * 0.25;
 }
 
-float lamp_shadow(float row, vec3 d, vec3 n) {
+float lamp_shadow(float row, vec3 d) {
     vec3 a = abs(d);
     int face = (a.x >= a.y && a.x >= a.z) ? (d.x > 0.0 ? 0 : 1) : (a.y >= a.z ? (d.y > 0.0 ? 2 : 3) : (d.z > 0.0 ? 4 : 5));
     vec4 c = u_face_matrix[face] * vec4(d, 1.0);
     vec2 uv = clamp(c.xy / c.w * 0.5 + 0.5, 1.5 / u_tile, 1.0 - 1.5 / u_tile);
     vec2 texel = (vec2(float(face), row) + uv) * u_tile;
-    float reach = length(d) - 0.02 - 0.01 * length(d);
+    float reach = length(d) - 0.01 - 0.005 * length(d);
     float lit = 0.0;
     lit += step(reach, texture(u_point_shadow, (texel + vec2(-0.7, -0.3)) / u_atlas_texels).r);
     lit += step(reach, texture(u_point_shadow, (texel + vec2(0.3, -0.7)) / u_atlas_texels).r);
@@ -224,7 +227,7 @@ void main() {
     vec4 m0 = texelFetch(u_materials, ivec2(0, v_material), 0);
     vec4 m1 = texelFetch(u_materials, ivec2(1, v_material), 0);
     vec4 m2 = texelFetch(u_materials, ivec2(2, v_material), 0);
-    vec4 ambient_room = texelFetch(u_instances, ivec2(v_instance, 0), 0);
+    vec4 instance_room = texelFetch(u_instances, ivec2(v_instance, 0), 0);
     vec4 emission_kind = texelFetch(u_instances, ivec2(v_instance, 1), 0);
     vec4 levels = texelFetch(u_instances, ivec2(v_instance, 2), 0);
     int kind = int(emission_kind.a + 0.5);
@@ -232,6 +235,12 @@ void main() {
     vec3 v = normalize(u_eye - v_world);
     vec3 n = normalize(v_normal);
     if (dot(n, v) < 0.0) n = -n;                       // thin parts are seen from both sides
+    vec3 geometric = n;                                // before normal detail: for shadow offsets
+    // The room this surface faces (a wall's far side, a door leaf seen from the next room belong
+    // to the room in front of them), for its ambient light and for which lamps reach it.
+    int room = int(texture(u_room_map, (v_world.xy + geometric.xy * 0.12 - u_room_box.xy) * u_room_box.zw).r + 0.5) - 1;
+    if (room < 0) room = int(instance_room.a + 0.5);
+    vec3 ambient = texelFetch(u_room_light, ivec2(room, 0), 0).rgb;
     vec3 seeded = v_local + (kind >= KIND_OBJECT ? hash12(vec2(float(v_instance), 1.0)) * 37.0 : 0.0);
     Surface s = pattern(m0.rgb, m2.rgb, m1.x, m1.y, m1.z, m1.w, seeded);
     n = bumped(n, v_world, s.height, m2.a);
@@ -242,7 +251,7 @@ void main() {
         // Window glass: the outdoors through it, the room faintly reflected.
         vec3 through = outdoor(-v);
         float fresnel = 0.04 + 0.96 * pow(1.0 - max(dot(n, v), 0.0), 5.0);
-        colour = mix(through * vec3(0.92, 0.96, 0.95), ambient_room.rgb * 0.5, fresnel);
+        colour = mix(through * vec3(0.92, 0.96, 0.95), ambient * 0.5, fresnel);
     }
 #else
     {
@@ -264,16 +273,16 @@ void main() {
         vec3 r = reflect(-v, n);
         float surround = mix(0.35, 1.4, clamp(r.z * 0.5 + 0.5, 0.0, 1.0));
         vec3 env_f = f0 + (1.0 - f0) * pow(1.0 - max(dot(n, v), 0.0), 5.0) * (1.0 - s.roughness);
-        colour = ambient_room.rgb * occlusion * (diffuse_albedo + env_f * surround * (1.0 - 0.7 * s.roughness));
+        colour = ambient * occlusion * (diffuse_albedo + env_f * surround * (1.0 - 0.7 * s.roughness));
 #if PATTERN_ID == PATTERN_MIRROR || PATTERN_ID == PATTERN_SCREEN
         float band = smoothstep(-0.05, 0.05, r.z);
-        vec3 room_seen = ambient_room.rgb * mix(vec3(0.55, 0.5, 0.45), vec3(1.3), band) * (0.8 + 0.4 * fbm(r * 3.0));
+        vec3 room_seen = ambient * mix(vec3(0.55, 0.5, 0.45), vec3(1.3), band) * (0.8 + 0.4 * fbm(r * 3.0));
         colour = PATTERN_ID == PATTERN_MIRROR ? room_seen * 0.9 : colour + room_seen * 0.08;
 #endif
         // The sun.
         float n_l = dot(n, u_sun_dir);
         if (n_l > 0.0 && dot(u_sun_irradiance, vec3(1.0)) > 1e-4) {
-            float lit = u_shadows == 1 ? sun_shadow(v_world, normalize(v_normal)) : 1.0;
+            float lit = u_shadows == 1 ? sun_shadow(v_world, geometric) : 1.0;
             colour += brdf(n, v, u_sun_dir, s.albedo, s.roughness, s.metalness) * u_sun_irradiance * n_l * lit;
         }
         // Lamps and ceiling lights, branch-free (a CPU rasteriser pays for divergent branches):
@@ -289,8 +298,8 @@ void main() {
             float n_l_lamp = max(dot(n, l), 0.0);
             float window = clamp(1.0 - dist2 * dist2 / (range2 * range2), 0.0, 1.0);
             float row = u_light_power[i].w;
-            float here = row >= 0.0 ? 1.0 : step(abs(u_light_room[i] - ambient_room.a), 0.5);
-            float lit = (row >= 0.0 && u_shadows == 1 && n_l_lamp > 0.0) ? lamp_shadow(row, d, n) : 1.0;
+            float here = float((u_light_rooms[i] >> room) & 1);
+            float lit = (row >= 0.0 && here > 0.0 && n_l_lamp > 0.0) ? lamp_shadow(row, d + geometric * 0.02) : 1.0;
             float n_h = max(dot(n, normalize(v + l)), 0.0);
             vec3 irradiance = u_light_power[i].rgb * (window * window * here * lit * n_l_lamp / (dist2 + 0.04));
             colour += irradiance * (lamp_diffuse + f0 * lobe * pow(n_h, shininess));
