@@ -1,0 +1,159 @@
+"""The realistic renderer on fixed scenes: sun shadows and window light, sunset colour, lamps without
+halos, textures, and RGB/depth/instance edges that line up (issue: images that look like photos).
+
+Every comparison of brightness uses a fixed exposure (the camera in manual mode), so it measures
+the light in the scene, not the auto-exposure's reaction to it.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import cv2
+import numpy as np
+import pytest
+from test_sensors import PROFILE, _box_house, _world
+
+from ravh_sim.render.materials import noise_volume
+from ravh_sim.sensors.camera import CameraOptions, SmartCamera
+from ravh_sim.world.appearance import Appearance, sun_light
+
+EXPOSURE = CameraOptions(manual_exposure=1.0)
+
+
+@pytest.fixture(scope="module")
+def world():
+    with _world(_box_house()) as w:
+        if w.renderer != "gl":
+            pytest.fail("the GL renderer must start on this machine (EGL + llvmpipe)")
+        yield w
+
+
+@pytest.fixture()
+def appearance(world):
+    app = Appearance(world)
+    before = replace(world.settings)
+    yield app
+    app.apply(before)
+
+
+def _camera(world, quality="realistic", options=EXPOSURE):
+    return SmartCamera(world, replace(PROFILE.camera, quality=quality), options)
+
+
+def _luminance(rgb: np.ndarray) -> np.ndarray:
+    return cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY).astype(np.float64)
+
+
+def _patch(image: np.ndarray, uv: np.ndarray, half: int = 4) -> float:
+    u, v = (int(round(c)) for c in uv)
+    return float(image[v - half:v + half + 1, u - half:u + half + 1].mean())
+
+
+def _floor_hit(sun_angle: float, through: tuple[float, float, float]) -> np.ndarray:
+    """Where the sun's ray through a point lands on the floor (z = 0)."""
+    d = np.asarray(sun_light(sun_angle).direction)
+    p = np.asarray(through)
+    return p - d * (p[2] / d[2])
+
+
+AFTERNOON = 150.0                       # the sun low in the west: it shines through room A's west window
+VIEW_WEST = (5.8, 2.3, math.pi)
+
+
+def test_sunlight_through_the_window_makes_a_bright_floor_patch(world, appearance):
+    appearance.set_sun(AFTERNOON)
+    appearance.set_lights("all", "off")
+    camera = _camera(world)
+    patch = _floor_hit(AFTERNOON, (-0.05, 2.0, 1.5))                 # the window's centre
+    elsewhere = patch + np.array([0.0, -1.6, 0.0])                   # same distance, not in the sun
+    assert 0.5 < patch[0] < 5.5 and 0.2 < elsewhere[1]               # both on room A's floor
+    cap = camera.capture(*VIEW_WEST)
+    lum = _luminance(cap.rgb)
+    uv = camera.project(np.array([patch, elsewhere]), *VIEW_WEST)
+    floor = world.instance("A/floor").id
+    assert all(cap.instance[int(round(v)), int(round(u))] == floor for u, v in uv)
+    assert _patch(lum, uv[0]) > 1.6 * _patch(lum, uv[1])
+
+
+def test_walls_and_ceiling_shadow_the_sun(world, appearance):
+    """The same floor point under the afternoon sun: lit when shadows are off (fast quality),
+    dark when the walls and ceiling are allowed to block the sun (realistic)."""
+    appearance.set_sun(AFTERNOON)
+    appearance.set_lights("all", "off")
+    point = _floor_hit(AFTERNOON, (-0.05, 2.0, 1.5)) + np.array([0.0, -1.6, 0.0])
+    seen = {}
+    for quality in ("realistic", "fast"):
+        camera = _camera(world, quality)
+        cap = camera.capture(*VIEW_WEST)
+        seen[quality] = _patch(_luminance(cap.rgb), camera.project(point[None], *VIEW_WEST)[0])
+    assert seen["realistic"] < 0.7 * seen["fast"]
+
+
+def test_sunset_moves_the_sun_and_colours_its_light_not_every_surface(world, appearance):
+    noon, sunset = sun_light(100.0), sun_light(180.0)
+    assert math.degrees(math.acos(np.dot(noon.direction, sunset.direction))) > 45
+    appearance.set_sun("sunset")
+    appearance.set_lights("all", "off")
+    appearance.set_paint("A", "walls", "white")
+    appearance.set_paint("A", "floor", "walnut")
+    cap = _camera(world, options=CameraOptions()).capture(4.5, 2.0, math.pi)
+    hsv = cv2.cvtColor(cap.rgb, cv2.COLOR_RGB2HSV).astype(np.float64)
+    wall = cap.instance == world.instance("A/walls").id
+    floor = cap.instance == world.instance("A/floor").id
+    assert wall.mean() > 0.2 and floor.mean() > 0.1
+    # A white wall stays far less saturated than a brown floor: the sunset is not a global tint.
+    assert hsv[..., 1][wall].mean() < 0.6 * hsv[..., 1][floor].mean()
+    assert abs(hsv[..., 0][wall].mean() - hsv[..., 0][floor].mean()) > 3 or \
+        hsv[..., 2][wall].mean() > 1.3 * hsv[..., 2][floor].mean()
+
+
+def test_one_lamp_at_night_lights_near_more_than_far_without_halos(world, appearance):
+    appearance.set_sun("night")
+    appearance.set_lights("all", "off")
+    appearance.set_light("Light_0", True)                            # over (3, 2)
+    camera = _camera(world, options=CameraOptions(manual_exposure=3.0))
+    pose = (5.5, 3.5, math.radians(-150))
+    cap = camera.capture(*pose)
+    lum = _luminance(cap.rgb)
+    near, far = camera.project(np.array([[3.0, 2.0, 0.0], [1.0, 0.4, 0.0]]), *pose)
+    assert _patch(lum, near) > 1.8 * _patch(lum, far) > 0
+    # No bright ring: just outside the window's silhouette the wall is no brighter than a bit further out.
+    window = (cap.instance == world.instance("Wall_0").id).astype(np.uint8)
+    if window.sum() > 500:
+        wall = cap.instance == world.instance("A/walls").id
+        ring = (cv2.dilate(window, np.ones((5, 5), np.uint8)) > 0) & ~window.astype(bool) & wall
+        outer = (cv2.dilate(window, np.ones((15, 15), np.uint8)) > 0) & \
+            ~(cv2.dilate(window, np.ones((9, 9), np.uint8)) > 0) & wall
+        assert lum[ring].mean() < 1.1 * lum[outer].mean() + 2
+
+
+def test_surfaces_carry_texture(world, appearance):
+    appearance.set_sun("day")
+    appearance.set_paint("A", "floor", "parquet")
+    cap = _camera(world, options=CameraOptions()).capture(5.0, 2.0, math.pi)
+    lum = _luminance(cap.rgb)
+    detail = np.abs(lum - cv2.GaussianBlur(lum, (0, 0), 6))          # texture, not shading
+    floor = cv2.erode((cap.instance == world.instance("A/floor").id).astype(np.uint8), np.ones((9, 9))) > 0
+    assert floor.mean() > 0.1
+    assert detail[floor].std() > 2.5
+    assert noise_volume().std() > 30                                  # the noise behind the patterns
+
+
+def test_rgb_depth_and_instance_edges_line_up(world, appearance):
+    appearance.set_sun("day")
+    cap = _camera(world, options=CameraOptions()).capture(2.0, 1.0, 0.25)      # the doorway to B
+    inst = cap.instance.astype(np.int32)
+    boundary = np.zeros(inst.shape, bool)
+    boundary[:, 1:] |= inst[:, 1:] != inst[:, :-1]
+    boundary[1:, :] |= inst[1:, :] != inst[:-1, :]
+    depth = np.nan_to_num(cap.depth, nan=100.0)
+    jump = np.zeros(inst.shape, bool)
+    jump[:, 1:] |= np.abs(depth[:, 1:] - depth[:, :-1]) > 0.1
+    jump[1:, :] |= np.abs(depth[1:, :] - depth[:-1, :]) > 0.1
+    occlusion = jump & boundary                                       # one thing in front of another
+    assert occlusion.sum() > 100
+    lum = _luminance(cap.rgb)
+    gradient = np.hypot(cv2.Sobel(lum, cv2.CV_64F, 1, 0), cv2.Sobel(lum, cv2.CV_64F, 0, 1))
+    strong = cv2.dilate(gradient, np.ones((3, 3), np.uint8))          # within 1 px
+    assert (strong[occlusion] > 20).mean() > 0.8                      # colour edges sit on mask edges
