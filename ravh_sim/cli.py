@@ -167,6 +167,13 @@ def cmd_render(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_gallery(args: argparse.Namespace) -> int:
+    from ravh_sim.viz.gallery import gallery
+    pose = tuple(args.pose) if args.pose else None
+    print(f"wrote {gallery(args.house, args.output, args.seed, pose, args.renderer)}")
+    return 0
+
+
 def _sun_value(text: str) -> float | str:
     """--sun: degrees or a preset name."""
     try:
@@ -265,6 +272,15 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--profile", default="giraff", help="robot profile for the camera (default: giraff)")
     p.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     p.set_defaults(func=cmd_render)
+
+    p = sub.add_parser("gallery", help="contact sheet of one view under the five raid presets and a random look")
+    p.add_argument("house", type=int, help="house number (1..30)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--pose", type=float, nargs=3, metavar=("X", "Y", "YAW"), default=None,
+                   help="robot pose (default: the room-centre view with the most objects)")
+    p.add_argument("--renderer", choices=BACKENDS, default="auto")
+    p.add_argument("-o", "--output", type=Path, required=True, help="PNG file")
+    p.set_defaults(func=cmd_gallery)
 
     p = sub.add_parser("raid", help="collect a dataset: sim + behaviour + recorder with a paper preset")
     p.add_argument("--house", type=int, default=15, help="house number (default 15)")

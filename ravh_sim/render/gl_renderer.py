@@ -361,13 +361,13 @@ class GLRenderer:
             for face, matrix in enumerate(self._face_matrices(lt.range)):
                 self.atlas_fbo.viewport = (face * LAMP_TILE, row * LAMP_TILE, LAMP_TILE, LAMP_TILE)
                 self._draw_casters(matrix, np.asarray(lt.position))
-        self._set("u_face_matrix", b"".join(_mat(m) for m in self._face_matrices(1.0)))
         self._set("u_atlas_texels", (float(size[0]), float(size[1])))
         self._set("u_tile", float(LAMP_TILE))
 
     @staticmethod
     def _face_matrices(reach: float) -> list[np.ndarray]:
-        """View-projections of the six cube faces (+x, -x, +y, -y, +z, -z) around a lamp at the origin."""
+        """View-projections of the six cube faces (+x, -x, +y, -y, +z, -z) around a lamp at the origin
+        (scene.frag's lamp_shadow inverts them in closed form: keep the two in step)."""
         projection = perspective(math.pi / 2, 1.0, 0.02, max(reach, 0.1))
         axes = [((1, 0, 0), (0, 0, 1)), ((-1, 0, 0), (0, 0, 1)), ((0, 1, 0), (0, 0, 1)),
                 ((0, -1, 0), (0, 0, 1)), ((0, 0, 1), (0, 1, 0)), ((0, 0, -1), (0, 1, 0))]

@@ -30,7 +30,6 @@ uniform int u_light_count;
 uniform vec4 u_light_position[MAX_LIGHTS];   // xyz, range
 uniform vec4 u_light_power[MAX_LIGHTS];      // rgb, shadow row (-1: none; then confined to its room)
 uniform int u_light_rooms[MAX_LIGHTS];       // bit r: the light reaches room r (its own, open doors)
-uniform mat4 u_face_matrix[6];
 uniform vec2 u_atlas_texels;                 // atlas size in texels
 uniform float u_tile;                        // texels per cube face
 uniform int u_shadows;                       // realistic quality: shadows on
@@ -54,11 +53,11 @@ Surface pattern(vec3 base, vec3 accent, float rough, float metal, float scale, f
     {
         float along = n.z > 0.7 ? p.x : p.z;
         float across = n.z > 0.7 ? p.y : (n.x > n.y ? p.y : p.x);
-        float warp = 2.0 * fbm(vec3(along * 1.2, across * 3.0, 0.0));
+        float warp = 0.7 * fbm(vec3(along * 0.4, across * 2.0, 0.0));
         float ring = fract(across * scale + warp);
         float streak = 0.6 * vnoise(vec3(along * 2.0, across * 18.0, 3.0)) + 0.4 * grain(vec3(along * 40.0, across * 400.0, 3.0));
-        float t = smoothstep(0.15, 0.85, ring) * 0.65 + 0.35 * streak;
-        s.albedo = mix(base, accent, t * variation * 2.0);
+        float t = smoothstep(0.3, 0.9, ring) * 0.55 + 0.45 * streak;
+        s.albedo = mix(base, accent, t * variation * 1.3);
         s.height = t;
     }
 #elif PATTERN_ID == PATTERN_PARQUET
@@ -92,9 +91,9 @@ Surface pattern(vec3 base, vec3 accent, float rough, float metal, float scale, f
     }
 #elif PATTERN_ID == PATTERN_MARBLE
     {
-        float v = abs(sin(dot(p, vec3(1.0, 0.6, 0.3)) * scale * 3.0 + 6.0 * fbm(p * scale)));
-        float vein = smoothstep(0.0, 0.15, v);
-        s.albedo = mix(accent, base, mix(1.0, vein, variation * 2.5)) * (0.96 + 0.08 * fbm(p * 9.0));
+        float v = abs(sin(dot(p, vec3(1.0, 0.6, 0.3)) * scale * 2.0 + 5.0 * fbm(p * scale)));
+        float vein = smoothstep(0.0, 0.05, v) * 0.7 + 0.3 * smoothstep(0.0, 0.3, v);
+        s.albedo = mix(mix(base, accent, 0.6), base, mix(1.0, vein, variation * 2.5)) * (0.95 + 0.1 * fbm(p * 9.0));
         s.height = vein * 0.2;
     }
 #elif PATTERN_ID == PATTERN_FABRIC
@@ -208,12 +207,24 @@ float sun_shadow(vec3 p, vec3 n) {
     return lit * 0.25;
 }
 
+// The cube faces' projections written out (90 degree views along +x, -x, +y, -y, +z, -z with the
+// up vectors of GLRenderer._face_matrices): no dynamically indexed matrices, which are slow here.
 float lamp_shadow(float row, vec3 d) {
     vec3 a = abs(d);
-    int face = (a.x >= a.y && a.x >= a.z) ? (d.x > 0.0 ? 0 : 1) : (a.y >= a.z ? (d.y > 0.0 ? 2 : 3) : (d.z > 0.0 ? 4 : 5));
-    vec4 c = u_face_matrix[face] * vec4(d, 1.0);
-    vec2 uv = clamp(c.xy / c.w * 0.5 + 0.5, 1.5 / u_tile, 1.0 - 1.5 / u_tile);
-    vec2 texel = (vec2(float(face), row) + uv) * u_tile;
+    float face;
+    vec2 ndc;
+    if (a.x >= a.y && a.x >= a.z) {
+        face = d.x > 0.0 ? 0.0 : 1.0;
+        ndc = vec2(d.x > 0.0 ? -d.y : d.y, d.z) / a.x;
+    } else if (a.y >= a.z) {
+        face = d.y > 0.0 ? 2.0 : 3.0;
+        ndc = vec2(d.y > 0.0 ? d.x : -d.x, d.z) / a.y;
+    } else {
+        face = d.z > 0.0 ? 4.0 : 5.0;
+        ndc = vec2(d.z > 0.0 ? -d.x : d.x, d.y) / a.z;
+    }
+    vec2 uv = clamp(ndc * 0.5 + 0.5, 1.5 / u_tile, 1.0 - 1.5 / u_tile);
+    vec2 texel = (vec2(face, row) + uv) * u_tile;
     float reach = length(d) - 0.01 - 0.005 * length(d);
     float lit = 0.0;
     lit += step(reach, texture(u_point_shadow, (texel + vec2(-0.7, -0.3)) / u_atlas_texels).r);
