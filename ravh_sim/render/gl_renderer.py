@@ -287,12 +287,15 @@ class GLRenderer:
                     program[name].value = value
 
     def _set_frame_lights(self, position: np.ndarray) -> None:
-        """The lamps that can light this view: the nearest FRAME_LIGHTS switched-on ones within
-        FRAME_LIGHT_REACH (a CPU rasteriser pays for every light on every pixel)."""
+        """The lamps that can light this view: switched-on lights reaching the camera's room or a
+        room open to it, the nearest FRAME_LIGHTS of them within FRAME_LIGHT_REACH (a CPU
+        rasteriser pays for every light on every pixel)."""
         index = {room.id: i for i, room in enumerate(self.world.house.rooms)}
         assert len(index) <= 32, "a light's room mask holds 32 rooms"
+        camera_room = self.world.house.room_at(float(position[0]), float(position[1]))
+        around = self._lit_rooms(camera_room.id) if camera_room is not None else set(index)
         near = sorted((float(np.linalg.norm(np.asarray(lt.position) - position)), row, lt)
-                      for row, lt in enumerate(self._lights))
+                      for row, lt in enumerate(self._lights) if self._lit_rooms(lt.room) & around)
         chosen = [(row, lt) for d, row, lt in near if d < FRAME_LIGHT_REACH][:FRAME_LIGHTS]
         positions = np.zeros((MAX_LIGHTS, 4), np.float32)
         powers = np.zeros((MAX_LIGHTS, 4), np.float32)
