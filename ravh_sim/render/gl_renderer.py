@@ -27,6 +27,7 @@ from ravh_sim.render.geometry import ATTRIBUTES, VERTEX_FORMAT, SceneBuilder
 from ravh_sim.render.materials import NOISE_TEXELS, PATTERN, TEXELS, MaterialTable, noise_volume, srgb_to_linear
 from ravh_sim.render.projection import look_at, orthographic, perspective, projection_from_K, view_matrix
 from ravh_sim.world.appearance import SunLight, sun_light
+from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import Light
 from ravh_sim.world.scene import World
 from ravh_sim.world.topology import room_index_raster, room_links
@@ -37,6 +38,11 @@ FRAME_LIGHTS = 6                      # lights shading one frame (the nearest)
 FRAME_LIGHT_REACH = 9.0               # m: lights farther from the camera are left out of a frame
 SUN_SHADOW_TEXELS = 2048
 LAMP_TILE = 192                       # texels per cube face of a lamp's shadow map
+PROBE_TILE = 64                       # texels per cube face of a room's reflection probe
+PROBE_HEIGHT = 1.3                    # m above the floor where a room's probe sits
+PROBE_FAR = 30.0
+FACE_AXES = (((1, 0, 0), (0, 0, 1)), ((-1, 0, 0), (0, 0, 1)), ((0, 1, 0), (0, 0, 1)),
+             ((0, -1, 0), (0, 0, 1)), ((0, 0, 1), (0, 1, 0)), ((0, 0, -1), (0, 1, 0)))
 COVERAGE_TEXELS = 512
 ROOM_MAP_RESOLUTION = 0.05            # m per cell of the floor-plan room map
 COVERAGE_BLUR_M = 0.12                # sigma of the floor occlusion blur
@@ -76,6 +82,11 @@ def _header(pattern: int = -1) -> str:
     defines += [f"#define KIND_{name.upper()} {i}" for name, i in KINDS.items()]
     defines.append(f"#define MAX_LIGHTS {MAX_LIGHTS}")
     return "#version 430\n" + "\n".join(defines) + "\n" + _source("common.glsl") + "\n"
+
+
+def _either(texture, stand_in):
+    """A texture, or a stand-in bound in its place where a quality has none (never sampled then)."""
+    return texture if texture is not None else stand_in
 
 
 def _mat(m: np.ndarray) -> bytes:
@@ -145,6 +156,9 @@ class GLRenderer:
         self.atlas_fbo = None
         self.instance_texture = None
         self.room_light = None
+        self.probes = None
+        self.probe_fbo = None
+        self.probe_boxes = None
         labels, origin = room_index_raster(world.house, ROOM_MAP_RESOLUTION)
         self.room_map = self._nearest_texture((labels.shape[1], labels.shape[0]), labels.astype(np.float32), 1)
         self.room_map.repeat_x = self.room_map.repeat_y = False
@@ -153,6 +167,7 @@ class GLRenderer:
                           1.0 / width_m, 1.0 / height_m)
         self.vbo = None
         self.vaos: dict[str, object] = {}
+        self._room_vaos: dict[str, tuple] = {}
         self._geometry_revision = -1
         self._light_key: tuple | None = None
         self._bounds = (np.zeros(3), np.ones(3))
@@ -164,7 +179,8 @@ class GLRenderer:
                     self.coverage_program, self.meter_program, self.meter, self.meter_fbo, self.hdr, self.depth, self.instance, self.main_fbo, self.ldr,
                     self.ldr_fbo, self.sun_depth, self.sun_fbo, self.coverage_raw, self.coverage_fbo,
                     self.coverage, self.noise, self.room_map, self.room_light, self.instance_texture,
-                    self.atlas, self.atlas_fbo, self.vbo, *self.vaos.values()):
+                    self.probes, self.probe_fbo, self.probe_boxes, self.atlas, self.atlas_fbo, self.vbo, *self.vaos.values(),
+                    *(obj for subset in self._room_vaos.values() for obj in subset)):
             if obj is not None:
                 obj.release()
 
@@ -188,6 +204,9 @@ class GLRenderer:
                 self._render_sun_shadow(sun)
                 self._render_lamp_shadows(lights)
             self._light_key = key
+            self._bind_textures()
+            if self.shadows:
+                self._render_probes()
 
     def _upload_geometry(self) -> None:
         vertices = self.builder.build()
@@ -204,7 +223,11 @@ class GLRenderer:
             self.vbo.release()
             for vao in self.vaos.values():
                 vao.release()
+            for subset in self._room_vaos.values():
+                for obj in subset:
+                    obj.release()
         self.vbo = self.ctx.buffer(vertices.tobytes())
+        self._room_vaos = self._room_subsets(vertices)
         skip = "3f 3x4 3x4 1f 1x4"
         self.vaos = {
             **{f"scene{k}": self.ctx.vertex_array(self.scene_programs[k], [(self.vbo, VERTEX_FORMAT, *ATTRIBUTES)])
@@ -217,6 +240,26 @@ class GLRenderer:
         table = self.materials.pack()
         self.material_texture = self.ctx.texture((TEXELS, len(table)), 4, table.tobytes(), dtype="f4")
         self.material_texture.filter = (self.ctx.NEAREST, self.ctx.NEAREST)
+
+    def _room_subsets(self, vertices: np.ndarray) -> dict[str, tuple]:
+        """Per room, (shadow VAO, probe VAO) over only the triangles of that room and the rooms open
+        to it: what a lamp's shadow map or a room's probe can see (walls hide the rest), so those
+        many small renders do not each process the whole house."""
+        house = self.world.house
+        room_of_instance = {inst.id: inst.room for inst in self.world.instances}
+        vertex_room = np.array([room_of_instance.get(int(i), "") for i in vertices[::3, 10]])
+        out = {}
+        for room in house.rooms:
+            triangles = np.flatnonzero(np.isin(vertex_room, sorted(self._lit_rooms(room.id))))
+            indices = (triangles[:, None] * 3 + np.arange(3)).astype(np.int32).ravel()
+            ibo = self.ctx.buffer(indices.tobytes())
+            out[room.id] = (
+                self.ctx.vertex_array(self.shadow_program, [(self.vbo, "3f 3x4 3x4 1f 1x4", "in_position",
+                                                             "in_material")], index_buffer=ibo),
+                self.ctx.vertex_array(self.scene_programs[PATTERN["plain"]],
+                                      [(self.vbo, VERTEX_FORMAT, *ATTRIBUTES)], index_buffer=ibo),
+                ibo)
+        return out
 
     def _upload_instances(self, sun: SunLight, lights: list[Light]) -> None:
         """Per instance: its room, a fixture's glow and the kind, the room's floor and ceiling
@@ -232,11 +275,14 @@ class GLRenderer:
             data[1, inst.id] = (*glow.get(inst.name, (0.0, 0.0, 0.0)), KINDS[inst.kind])
             data[2, inst.id, :2] = (room.floor_z, room.ceiling_z)
         ambient = np.array([[*self._room_ambient(room, sun, lights), 0.0] for room in house.rooms], np.float32)
-        for old in (self.instance_texture, self.room_light):
-            if old is not None:
-                old.release()
-        self.instance_texture = self._nearest_texture((size, 3), data)
-        self.room_light = self._nearest_texture((len(house.rooms), 1), ambient)
+        self.instance_texture = self._replace(self.instance_texture, self._nearest_texture((size, 3), data))
+        self.room_light = self._replace(self.room_light, self._nearest_texture((len(house.rooms), 1), ambient))
+
+    @staticmethod
+    def _replace(old, new):
+        if old is not None:
+            old.release()
+        return new
 
     def _nearest_texture(self, size: tuple[int, int], data: np.ndarray, components: int = 4):
         texture = self.ctx.texture(size, components, np.ascontiguousarray(data, np.float32).tobytes(), dtype="f4")
@@ -333,11 +379,13 @@ class GLRenderer:
         matrix = projection @ view
         bias = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5], [0, 0, 0, 1]])
         self._sun_matrix = bias @ matrix
+        self._set("u_sun_matrix", _mat(self._sun_matrix))
         self.sun_fbo.use()
         self.sun_fbo.clear(depth=1.0)
         self._draw_casters(matrix, np.zeros(3))
 
-    def _draw_casters(self, matrix: np.ndarray, origin: np.ndarray) -> None:
+    def _draw_casters(self, matrix: np.ndarray, origin: np.ndarray, room: str | None = None) -> None:
+        """Shadow casters into the framebuffer in use: the whole house, or a room's subset."""
         ctx = self.ctx
         ctx.enable(ctx.DEPTH_TEST)
         ctx.disable(ctx.CULL_FACE)
@@ -345,7 +393,7 @@ class GLRenderer:
         self.shadow_program["u_materials"].value = 0
         self.shadow_program["u_matrix"].write(_mat(matrix))
         self.shadow_program["u_origin"].value = tuple(float(v) for v in origin)
-        self.vaos["shadow"].render()
+        (self.vaos["shadow"] if room is None else self._room_vaos[room][0]).render()
 
     def _render_lamp_shadows(self, lights: list[Light]) -> None:
         rows = max(len(lights), 1)
@@ -363,18 +411,54 @@ class GLRenderer:
         for row, lt in enumerate(lights):
             for face, matrix in enumerate(self._face_matrices(lt.range)):
                 self.atlas_fbo.viewport = (face * LAMP_TILE, row * LAMP_TILE, LAMP_TILE, LAMP_TILE)
-                self._draw_casters(matrix, np.asarray(lt.position))
+                self._draw_casters(matrix, np.asarray(lt.position), lt.room)
         self._set("u_atlas_texels", (float(size[0]), float(size[1])))
         self._set("u_tile", float(LAMP_TILE))
 
     @staticmethod
-    def _face_matrices(reach: float) -> list[np.ndarray]:
-        """View-projections of the six cube faces (+x, -x, +y, -y, +z, -z) around a lamp at the origin
-        (scene.frag's lamp_shadow inverts them in closed form: keep the two in step)."""
+    def _face_views() -> list[np.ndarray]:
+        """Views of the six cube faces (+x, -x, +y, -y, +z, -z) from the origin (scene.frag's
+        cube_texel inverts them in closed form: keep the two in step)."""
+        return [look_at(np.array(f, float), np.array(u, float)) for f, u in FACE_AXES]
+
+    def _face_matrices(self, reach: float) -> list[np.ndarray]:
         projection = perspective(math.pi / 2, 1.0, 0.02, max(reach, 0.1))
-        axes = [((1, 0, 0), (0, 0, 1)), ((-1, 0, 0), (0, 0, 1)), ((0, 1, 0), (0, 0, 1)),
-                ((0, -1, 0), (0, 0, 1)), ((0, 0, 1), (0, 1, 0)), ((0, 0, -1), (0, 1, 0))]
-        return [projection @ look_at(np.array(f, float), np.array(u, float)) for f, u in axes]
+        return [projection @ view for view in self._face_views()]
+
+    def _render_probes(self) -> None:
+        """Each room's reflection probe: the room seen from its middle in six directions, fully lit,
+        so mirrors and glossy surfaces reflect the room they are in."""
+        house = self.world.house
+        size = (6 * PROBE_TILE, len(house.rooms) * PROBE_TILE)
+        if self.probes is None or self.probes.size != size:
+            for obj in (self.probes, self.probe_fbo):
+                if obj is not None:
+                    obj.release()
+            self.probes = self.ctx.texture(size, 4, dtype="f2")
+            self.probe_fbo = self.ctx.framebuffer([self.probes], self.ctx.depth_renderbuffer(size))
+        boxes = np.zeros((3, len(house.rooms), 4), np.float32)
+        projection = perspective(math.pi / 2, 1.0, 0.05, PROBE_FAR)
+        self._set("u_probes_ready", 0)
+        self.probe_fbo.use()
+        self.probe_fbo.viewport = (0, 0, *size)
+        self.probe_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        for row, room in enumerate(house.rooms):
+            points = np.asarray([p for poly in (room.floor, *room.extra_floors) for p in poly])
+            lo = (*points.min(axis=0), room.floor_z)
+            hi = (*points.max(axis=0), room.ceiling_z)
+            x, y = polygon_centroid(room.floor)
+            centre = np.array([x, y, room.floor_z + PROBE_HEIGHT])
+            boxes[:, row, :3] = (lo, hi, centre)
+            self._set_frame_lights(centre)
+            for face, view in enumerate(self._face_views()):
+                view = view.copy()
+                view[:3, 3] = -view[:3, :3] @ centre
+                self.probe_fbo.viewport = (face * PROBE_TILE, row * PROBE_TILE, PROBE_TILE, PROBE_TILE)
+                self._draw_probe_face(view, projection @ view, centre, room.id)
+        self.probe_boxes = self._replace(self.probe_boxes, self._nearest_texture((len(house.rooms), 3), boxes))
+        self._set("u_probe_texels", (float(size[0]), float(size[1])))
+        self._set("u_probe_tile", float(PROBE_TILE))
+        self._set("u_probes_ready", 1)
 
     def _render_coverage(self) -> None:
         lo, hi = self._bounds
@@ -400,6 +484,50 @@ class GLRenderer:
         self._set("u_coverage_box", (x0, y0, 1.0 / span, 1.0 / span))
 
     # ------------------------------------------------------------------ frames
+    def _bind_textures(self) -> None:
+        units = (("u_materials", self.material_texture), ("u_instances", self.instance_texture),
+                 ("u_sun_shadow", self.sun_depth), ("u_point_shadow", _either(self.atlas, self.depth)),
+                 ("u_coverage", self.coverage), ("u_noise", self.noise), ("u_room_map", self.room_map),
+                 ("u_room_light", self.room_light), ("u_probes", _either(self.probes, self.hdr)),
+                 ("u_probe_boxes", _either(self.probe_boxes, self.room_light)))
+        for unit, (name, texture) in enumerate(units):
+            texture.use(unit)
+            self._set(name, unit, also=(self.sky_program,))
+        self._set("u_room_box", self._room_box)
+
+    def _draw_probe_face(self, view: np.ndarray, view_proj: np.ndarray, eye: np.ndarray, room: str) -> None:
+        """A probe face: every surface in one draw with the plain-pattern program (a reflection
+        needs the room's light and colours, not its wood grain), then the outdoors."""
+        ctx = self.ctx
+        self._set("u_view_proj", _mat(view_proj))
+        self._set("u_view", _mat(view))
+        self._set("u_eye", tuple(float(v) for v in eye))
+        ctx.enable(ctx.DEPTH_TEST)
+        ctx.depth_func = "<"
+        self._room_vaos[room][1].render()
+        ctx.depth_func = "<="
+        self.sky_program["u_inverse_view_proj"].write(_mat(np.linalg.inv(view_proj)))
+        self.empty_vao.render(vertices=3)
+
+    def _draw_view(self, view: np.ndarray, view_proj: np.ndarray, eye: np.ndarray) -> None:
+        """Depth pre-pass, one shading pass per pattern, then the outdoors where nothing was drawn,
+        into the framebuffer in use."""
+        ctx = self.ctx
+        self._set("u_view_proj", _mat(view_proj))
+        self._set("u_view", _mat(view))
+        self._set("u_eye", tuple(float(v) for v in eye))
+        ctx.enable(ctx.DEPTH_TEST)
+        ctx.disable(ctx.CULL_FACE)
+        # Depth first, then shade only the surviving fragment of each pixel (no overdraw).
+        ctx.depth_func = "<"
+        self.depth_program["u_view_proj"].write(_mat(view_proj))
+        self.vaos["depth"].render()
+        ctx.depth_func = "=="
+        for k, first, count in self._ranges:
+            self.vaos[f"scene{k}"].render(first=first, vertices=count)
+        ctx.depth_func = "<="
+        self.sky_program["u_inverse_view_proj"].write(_mat(np.linalg.inv(view_proj)))
+        self.empty_vao.render(vertices=3)
     def _exposure(self) -> float:
         """Auto-exposure: the frame's log-average luminance is metered and exposure makes up for
         part of its difference from a daylit room (a camera keeps a dusk room dimmer than a noon
@@ -416,38 +544,11 @@ class GLRenderer:
         ctx = self.ctx
         view = view_matrix(position, rotation)
         view_proj = self.projection @ view
-        self._set("u_view_proj", _mat(view_proj))
-        self._set("u_view", _mat(view))
-        self._set("u_eye", tuple(float(v) for v in position))
-        self._set("u_sun_matrix", _mat(self._sun_matrix))
         self._set_frame_lights(position)
-        self.material_texture.use(0)
-        self.instance_texture.use(1)
-        self.sun_depth.use(2)
-        (self.atlas if self.atlas is not None else self.depth).use(3)
-        self.coverage.use(4)
-        self.noise.use(5)
-        self.room_map.use(6)
-        self.room_light.use(7)
-        for name, unit in (("u_materials", 0), ("u_instances", 1), ("u_sun_shadow", 2),
-                           ("u_point_shadow", 3), ("u_coverage", 4), ("u_noise", 5), ("u_room_map", 6),
-                           ("u_room_light", 7)):
-            self._set(name, unit, also=(self.sky_program,))
-        self._set("u_room_box", self._room_box)
+        self._bind_textures()
         self.main_fbo.use()
         self.main_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        ctx.enable(ctx.DEPTH_TEST)
-        ctx.disable(ctx.CULL_FACE)
-        # Depth first, then shade only the surviving fragment of each pixel (no overdraw).
-        ctx.depth_func = "<"
-        self.depth_program["u_view_proj"].write(_mat(view_proj))
-        self.vaos["depth"].render()
-        ctx.depth_func = "=="
-        for k, first, count in self._ranges:
-            self.vaos[f"scene{k}"].render(first=first, vertices=count)
-        ctx.depth_func = "<="
-        self.sky_program["u_inverse_view_proj"].write(_mat(np.linalg.inv(view_proj)))
-        self.empty_vao.render(vertices=3)
+        self._draw_view(view, view_proj, position)
         ctx.depth_func = "<"
         ctx.disable(ctx.DEPTH_TEST)
         self.hdr.use(0)

@@ -87,7 +87,7 @@ def paint_material(paint: str, surface: str) -> Material:
     c = srgb_to_linear(tuple(v / 255 for v in paints.plain_rgb(paint)))
     if surface == "floor":
         return Material(c, "concrete", 0.7, scale=1.5, variation=0.12, accent=_scaled(c, 0.8), bump=0.2)
-    return Material(c, "plaster", 0.85, scale=3.0, variation=0.05, accent=_scaled(c, 0.9), bump=0.25)
+    return Material(c, "plaster", 0.85, scale=3.0, variation=0.05, accent=_scaled(c, 0.9), bump=0.1)
 
 
 _TEXTURE_PAINTS: dict[str, Material] = {

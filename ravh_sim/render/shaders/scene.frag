@@ -33,8 +33,18 @@ uniform int u_light_rooms[MAX_LIGHTS];       // bit r: the light reaches room r 
 uniform vec2 u_atlas_texels;                 // atlas size in texels
 uniform float u_tile;                        // texels per cube face
 uniform int u_shadows;                       // realistic quality: shadows on
+uniform sampler2D u_probes;                  // room probes: 6 faces per row, one row per room
+uniform sampler2D u_probe_boxes;             // rooms x 3: box min, box max, probe centre
+uniform vec2 u_probe_texels;
+uniform float u_probe_tile;
+uniform int u_probes_ready;                  // 0 while the probes themselves are rendered
 
 struct Surface { vec3 albedo; float roughness; float metalness; float height; };
+
+// Materials smooth enough to show their room's reflection (the others reflect a plain surround).
+#define GLOSSY (PATTERN_ID == PATTERN_MIRROR || PATTERN_ID == PATTERN_METAL || PATTERN_ID == PATTERN_SCREEN \
+    || PATTERN_ID == PATTERN_CERAMIC || PATTERN_ID == PATTERN_TILES || PATTERN_ID == PATTERN_MARBLE \
+    || PATTERN_ID == PATTERN_PARQUET || PATTERN_ID == PATTERN_LEATHER)
 
 vec3 face_normal_local() {
     return abs(normalize(cross(dFdx(v_local), dFdy(v_local))));
@@ -207,9 +217,10 @@ float sun_shadow(vec3 p, vec3 n) {
     return lit * 0.25;
 }
 
-// The cube faces' projections written out (90 degree views along +x, -x, +y, -y, +z, -z with the
-// up vectors of GLRenderer._face_matrices): no dynamically indexed matrices, which are slow here.
-float lamp_shadow(float row, vec3 d) {
+// Texel (in atlas texels) of direction d on cube row ``row``: the six 90 degree faces along +x, -x,
+// +y, -y, +z, -z with the up vectors of GLRenderer.FACE_AXES, their projections written out (no
+// dynamically indexed matrices, which are slow here). Lamp shadows and room probes share it.
+vec2 cube_texel(vec3 d, float row, float tile) {
     vec3 a = abs(d);
     float face;
     vec2 ndc;
@@ -223,8 +234,12 @@ float lamp_shadow(float row, vec3 d) {
         face = d.z > 0.0 ? 4.0 : 5.0;
         ndc = vec2(d.z > 0.0 ? -d.x : d.x, d.y) / a.z;
     }
-    vec2 uv = clamp(ndc * 0.5 + 0.5, 1.5 / u_tile, 1.0 - 1.5 / u_tile);
-    vec2 texel = (vec2(face, row) + uv) * u_tile;
+    vec2 uv = clamp(ndc * 0.5 + 0.5, 1.5 / tile, 1.0 - 1.5 / tile);
+    return (vec2(face, row) + uv) * tile;
+}
+
+float lamp_shadow(float row, vec3 d) {
+    vec2 texel = cube_texel(d, row, u_tile);
     float reach = length(d) - 0.01 - 0.005 * length(d);
     float lit = 0.0;
     lit += step(reach, texture(u_point_shadow, (texel + vec2(-0.7, -0.3)) / u_atlas_texels).r);
@@ -232,6 +247,19 @@ float lamp_shadow(float row, vec3 d) {
     lit += step(reach, texture(u_point_shadow, (texel + vec2(0.7, 0.3)) / u_atlas_texels).r);
     lit += step(reach, texture(u_point_shadow, (texel + vec2(-0.3, 0.7)) / u_atlas_texels).r);
     return lit * 0.25;
+}
+
+// What a mirror-like surface at p reflects along r: the room's probe (a cube map rendered from the
+// room's middle), looked up where r leaves the room's box so the reflection stands where the room is.
+vec3 room_reflection(int room, vec3 p, vec3 r) {
+    vec3 lo = texelFetch(u_probe_boxes, ivec2(room, 0), 0).xyz;
+    vec3 hi = texelFetch(u_probe_boxes, ivec2(room, 1), 0).xyz;
+    vec3 centre = texelFetch(u_probe_boxes, ivec2(room, 2), 0).xyz;
+    vec3 safe = sign(r) * max(abs(r), vec3(1e-4)) + vec3(equal(r, vec3(0.0))) * 1e-4;
+    vec3 far_t = max((hi - p) / safe, (lo - p) / safe);
+    float t = max(min(min(far_t.x, far_t.y), far_t.z), 0.0);
+    vec2 texel = cube_texel(p + r * t - centre, float(room), u_probe_tile);
+    return texture(u_probes, texel / u_probe_texels).rgb;
 }
 
 void main() {
@@ -284,11 +312,15 @@ void main() {
         vec3 r = reflect(-v, n);
         float surround = mix(0.35, 1.4, clamp(r.z * 0.5 + 0.5, 0.0, 1.0));
         vec3 env_f = f0 + (1.0 - f0) * pow(1.0 - max(dot(n, v), 0.0), 5.0) * (1.0 - s.roughness);
-        colour = ambient * occlusion * (diffuse_albedo + env_f * surround * (1.0 - 0.7 * s.roughness));
-#if PATTERN_ID == PATTERN_MIRROR || PATTERN_ID == PATTERN_SCREEN
-        float band = smoothstep(-0.05, 0.05, r.z);
-        vec3 room_seen = ambient * mix(vec3(0.55, 0.5, 0.45), vec3(1.3), band) * (0.8 + 0.4 * fbm(r * 3.0));
-        colour = PATTERN_ID == PATTERN_MIRROR ? room_seen * 0.9 : colour + room_seen * 0.08;
+        vec3 environment = ambient * surround;
+#if GLOSSY
+        if (u_probes_ready == 1) {
+            environment = mix(room_reflection(room, v_world, r), environment, s.roughness);
+        }
+#endif
+        colour = ambient * occlusion * diffuse_albedo + env_f * environment * (1.0 - 0.7 * s.roughness) * occlusion;
+#if PATTERN_ID == PATTERN_MIRROR
+        colour = environment * vec3(0.86, 0.9, 0.9);
 #endif
         // The sun.
         float n_l = dot(n, u_sun_dir);
