@@ -23,7 +23,8 @@ from ravh_sim.paths import ROBOTS_DIR
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.robot.robot import Odometry, Robot, relative, wrap_angle
 from ravh_sim.robot.simulation import Simulation
-from ravh_sim.world.scene import DOOR_LEAF_THICKNESS, World
+from ravh_sim.world.scene import World
+from ravh_sim.world.solids import DOOR_LEAF_THICKNESS
 from ravh_sim.world.settings import AgentSpec, resolve
 
 GIRAFF = load_profile("giraff")

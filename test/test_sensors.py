@@ -26,7 +26,8 @@ from ravh_sim.sensors.mount import LINK_TO_OPTICAL, quaternion_from_matrix
 from ravh_sim.world.appearance import Appearance, sun_light
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.house import HOUSE_FORMAT, house_from_dict
-from ravh_sim.world.scene import DOOR_LEAF_THICKNESS, World
+from ravh_sim.world.scene import World
+from ravh_sim.world.solids import DOOR_LEAF_THICKNESS
 from ravh_sim.world.settings import load_settings, resolve
 
 PROFILE = load_profile("giraff")
@@ -303,13 +304,13 @@ def test_closing_a_door_changes_laser_and_depth_in_the_doorway(world, camera, ap
     appearance.set_door("Door_0", False)
     closed_scan, closed_cap = laser.scan(*pose), camera.capture(*pose)
     assert open_scan.ranges[180] == pytest.approx(6.0, abs=0.01)            # room B's far wall
-    assert closed_scan.ranges[180] == pytest.approx(3.1 - 0.05, abs=0.01)   # the leaf's collision box
     door = world.instance("Door_0").id
     assert (open_cap.instance == door).mean() < 0.01 < (closed_cap.instance == door).mean()
     position, _ = camera.optical_pose(*pose)
     along_x = math.cos(math.radians(PROFILE.camera.pitch_deg))       # optical axis: x per metre of depth
     leaf_x = position[0] + closed_cap.depth[240, 320] * along_x
     assert 6.1 - DOOR_LEAF_THICKNESS <= leaf_x <= 6.1 + DOOR_LEAF_THICKNESS   # on the leaf model
+    assert closed_scan.ranges[180] == pytest.approx(leaf_x - pose[0], abs=0.003)  # the laser hits the leaf
     assert closed_cap.instance[240, 320] == door
     assert position[0] + open_cap.depth[240, 320] * along_x > 8.0            # into room B
     assert world.settings.doors["Door_0"] is False
