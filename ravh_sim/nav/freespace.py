@@ -82,7 +82,7 @@ def obstacles(house: House, door_open: Mapping[str, bool], models: Mapping[str, 
         if open_state[door.id]:
             _fill_box(known, _door_box(door), grid)
     blocked = np.zeros(grid.shape, np.uint8)
-    for box in _obstacle_boxes(house, open_state, models, height):
+    for box in _obstacle_boxes(house, open_state, models, height, resolution):
         _fill_box(blocked, box, grid)
     grid.data[known > 0] = FREE
     grid.data[blocked > 0] = OCCUPIED
@@ -115,8 +115,9 @@ Box = Footprint
 
 
 def _obstacle_boxes(house: House, open_state: Mapping[str, bool], models: Mapping[str, int],
-                    height: float) -> Iterator[Box]:
-    """Footprints of everything that blocks a robot of ``height``."""
+                    height: float, resolution: float = 0.0) -> Iterator[Box]:
+    """Footprints of everything that blocks a robot of ``height``; object parts thinner than
+    ``resolution`` grow to it inside their object (see ``Placed.footprints``)."""
     floor_z = {room.id: room.floor_z for room in house.rooms}
     for wall in house.walls:
         base = floor_z[wall.room]
@@ -128,8 +129,8 @@ def _obstacle_boxes(house: House, open_state: Mapping[str, bool], models: Mappin
     for obj in house.objects:
         if obj.type not in NON_OBSTACLE_TYPES:
             base = floor_z[obj.room]
-            yield from object_parts(house, obj, models.get(obj.id)).footprints(base + MIN_OBSTACLE_TOP,
-                                                                               base + height)
+            placed = object_parts(house, obj, models.get(obj.id))
+            yield from placed.footprints(base + MIN_OBSTACLE_TOP, base + height, resolution)
 
 
 def _wall_box(wall: Wall) -> Box:

@@ -41,18 +41,25 @@ class Placed:
         """The parts merged: what the camera draws."""
         return Mesh.merged(self.parts)
 
-    def footprints(self, z_low: float, z_high: float) -> Iterator[Footprint]:
+    def footprints(self, z_low: float, z_high: float, min_size: float = 0.0) -> Iterator[Footprint]:
         """Floor rectangles (in the body's yawed frame) of the parts that reach into the height
         band (z_low, z_high) of the house frame: a part's rectangle is its extent along the body's
-        axes, exact for the boxes most parts are and a little larger for round or slanted ones."""
+        axes, exact for the boxes most parts are and a little larger for round or slanted ones.
+
+        A rectangle narrower than ``min_size`` grows to it towards the middle of the object, so a
+        raster that draws thin shapes as lines one cell wide never draws beyond the object.
+        """
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         x, y, z = self.position
+        whole_lo, whole_hi = Mesh.merged(self.parts).bounds()
         for part in self.parts:
             lo, hi = part.bounds()
             if hi[2] + z <= z_low or lo[2] + z >= z_high:
                 continue
-            mx, my = (lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2
-            yield (x + c * mx - s * my, y + s * mx + c * my), (hi[0] - lo[0], hi[1] - lo[1]), self.yaw
+            half = np.maximum((hi - lo)[:2], min_size) / 2
+            middle = np.clip((lo + hi)[:2] / 2, np.minimum(whole_lo[:2] + half, 0.0),
+                             np.maximum(whole_hi[:2] - half, 0.0))
+            yield (x + c * middle[0] - s * middle[1], y + s * middle[0] + c * middle[1]), tuple(2 * half), self.yaw
 
 
 def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
