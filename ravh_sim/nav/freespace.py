@@ -4,7 +4,8 @@ The map is computed from the house model, not sensed, so navigation works from t
 agrees with the pybullet world by construction. Three steps, each its own function:
 
 1. :func:`obstacles` rasterises the house at one robot height: the union of the room floors (plus
-   open doorways) is the known area, everything else is UNKNOWN; wall pieces, columns, closed door
+   open doorways) is the known area, everything else is UNKNOWN; wall pieces and door jambs as the
+   world builds them (:func:`ravh_sim.world.structure.solid_walls`), columns, closed door
    leaves and the furniture parts that the robot's body would hit (legs, seats, a table top below
    the robot's height: :mod:`ravh_sim.world.solids`, the parts the world collides with) are
    OCCUPIED; the rest is FREE.
@@ -36,6 +37,7 @@ from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid
 from ravh_sim.world.geometry import box_corners
 from ravh_sim.world.house import Door, House, Wall
 from ravh_sim.world.solids import Footprint, object_parts
+from ravh_sim.world.structure import solid_walls
 
 NON_OBSTACLE_TYPES = frozenset({"Door", "Wall", "Light", "Station"})
 """Object types that never block: doors (handled through ``house.doors``), windows (inside the
@@ -119,7 +121,7 @@ def _obstacle_boxes(house: House, open_state: Mapping[str, bool], models: Mappin
     """Footprints of everything that blocks a robot of ``height``; object parts thinner than
     ``resolution`` grow to it inside their object (see ``Placed.footprints``)."""
     floor_z = {room.id: room.floor_z for room in house.rooms}
-    for wall in house.walls:
+    for wall in (w for room in house.rooms for w in solid_walls(house, room.id)):
         base = floor_z[wall.room]
         if wall.z0 < base + height and wall.z1 > base:
             yield _wall_box(wall)

@@ -29,7 +29,7 @@ from ravh_sim.world.mesh import hulls_obj_text
 from ravh_sim.world.palette import PALETTE
 from ravh_sim.world.settings import Resolved
 from ravh_sim.world.solids import Placed, door_pose, object_parts
-from ravh_sim.world.structure import TexturedMesh, floor_mesh, wall_mesh
+from ravh_sim.world.structure import TexturedMesh, floor_mesh, solid_walls, wall_mesh
 
 RENDERERS = ("auto", "egl", "tiny")
 NON_SOLID_TYPES = frozenset({"Station"})      # drawn, but the robot starts on it
@@ -168,7 +168,7 @@ class World:
     def _structure_body(self, inst: Instance) -> int:
         room = self.house.room(inst.room)
         if inst.kind == "walls":
-            walls = [w for w in self.house.walls if w.room == room.id]
+            walls = solid_walls(self.house, room.id)
             body = self._mesh_body(wall_mesh(walls), self._wall_collision(walls))
             self._apply_paint(body, self.settings.paint[room.id]["walls"])
         elif inst.kind == "floor":
