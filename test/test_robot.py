@@ -213,7 +213,8 @@ def test_a_start_inside_furniture_is_refused_naming_the_nearest_free_pose(make_w
     with pytest.raises(UserError, match=r"'robot': start pose \[-0.25, 0.95, 0.0\] is inside an obstacle; "
                                         r"nearest free pose: \[") as refused:
         Simulation(make_world(15, [AgentSpec("robot", "giraff", asked)]))
-    suggested = tuple(float(v) for v in str(refused.value).split("nearest free pose: [")[1].rstrip("]").split(","))
+    named = str(refused.value).split("nearest free pose: [")[1].rstrip("]")
+    suggested = tuple(float(v) for v in named.split(","))
     world = make_world(15, [AgentSpec("robot", "giraff", suggested)])
     sim = Simulation(world)
     robot = sim.robot("robot")

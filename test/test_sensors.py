@@ -357,7 +357,8 @@ def test_laser_and_depth_agree_on_walls_objects_and_doors(houses, number):
                 poses += [(cx, cy, k * math.pi / 2) for k in range(4)]
         differences: dict[str, list[float]] = {}
         for pose in poses:
-            for name, values in laser_minus_depth(laser, laser.scan(*pose), camera.capture(*pose), pose).items():
+            measured = laser_minus_depth(laser, laser.scan(*pose), camera.capture(*pose), pose)
+            for name, values in measured.items():
                 differences.setdefault(name, []).extend(values)
     for name in ("walls", "objects", "doors"):
         assert len(differences[name]) >= 20, name

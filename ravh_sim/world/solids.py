@@ -34,6 +34,7 @@ Footprint = tuple[tuple[float, float], tuple[float, float], float]
 class Placed:
     """An object's model parts in its body frame and the body's pose in the house."""
     parts: tuple[Mesh, ...]
+    bounds: np.ndarray                     # (parts, 2, 3): each part's min and max corner
     position: tuple[float, float, float]
     yaw: float
 
@@ -49,17 +50,16 @@ class Placed:
         A rectangle narrower than ``min_size`` grows to it towards the middle of the object, so a
         raster that draws thin shapes as lines one cell wide never draws beyond the object.
         """
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
         x, y, z = self.position
-        whole_lo, whole_hi = Mesh.merged(self.parts).bounds()
-        for part in self.parts:
-            lo, hi = part.bounds()
-            if hi[2] + z <= z_low or lo[2] + z >= z_high:
-                continue
-            half = np.maximum((hi - lo)[:2], min_size) / 2
-            middle = np.clip((lo + hi)[:2] / 2, np.minimum(whole_lo[:2] + half, 0.0),
-                             np.maximum(whole_hi[:2] - half, 0.0))
-            yield (x + c * middle[0] - s * middle[1], y + s * middle[0] + c * middle[1]), tuple(2 * half), self.yaw
+        lo, hi = self.bounds[:, 0], self.bounds[:, 1]
+        reach = (hi[:, 2] + z > z_low) & (lo[:, 2] + z < z_high)
+        lo, hi = lo[reach, :2], hi[reach, :2]
+        half = np.maximum(hi - lo, min_size) / 2
+        whole_lo, whole_hi = self.bounds[:, 0, :2].min(axis=0), self.bounds[:, 1, :2].max(axis=0)
+        middle = np.clip((lo + hi) / 2, np.minimum(whole_lo + half, 0.0), np.maximum(whole_hi - half, 0.0))
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        for (mx, my), (hx, hy) in zip(middle.tolist(), half.tolist()):
+            yield (x + c * mx - s * my, y + s * mx + c * my), (2 * hx, 2 * hy), self.yaw
 
 
 def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
@@ -67,19 +67,19 @@ def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
     if obj.id in house.door_by_id:
         return door_parts(house, house.door_by_id[obj.id], model)
     box = obj.box(model)
-    walls = [(w.a, w.b) for w in house.walls if w.room == obj.room and w.kind != "lintel"]
-    facing = choose_facing(box.position[:2], obj.yaw, box.size, walls, front=front_axis(obj.type))
+    walls = tuple((w.a, w.b) for w in house.walls if w.room == obj.room and w.kind != "lintel")
+    facing = _facing(tuple(box.position[:2]), obj.yaw, tuple(box.size), walls, front_axis(obj.type))
     variant = obj.default_model if model is None else model
-    parts = _parts(obj.type, tuple(box.size), variant, facing, obj.prefab)
-    return Placed(parts, tuple(box.position), obj.yaw)
+    parts, bounds = _parts(obj.type, tuple(box.size), variant, facing, obj.prefab)
+    return Placed(parts, bounds, tuple(box.position), obj.yaw)
 
 
 def door_parts(house: House, door: Door, model: int | None) -> Placed:
     """The closed door leaf (see :func:`door_pose`)."""
     width, _, height = door.leaf
     variant = house.object(door.id).default_model if model is None else model
-    parts = _parts("Door", (DOOR_LEAF_THICKNESS, width, height), variant, 0, "")
-    return Placed(parts, *door_pose(house, door))
+    parts, bounds = _parts("Door", (DOOR_LEAF_THICKNESS, width, height), variant, 0, "")
+    return Placed(parts, bounds, *door_pose(house, door))
 
 
 def door_pose(house: House, door: Door) -> tuple[tuple[float, float, float], float]:
@@ -91,6 +91,15 @@ def door_pose(house: House, door: Door) -> tuple[tuple[float, float, float], flo
 
 @functools.lru_cache(maxsize=8192)
 def _parts(object_type: str, size: tuple[float, float, float], variant: int, facing: int,
-           prefab: str) -> tuple[Mesh, ...]:
-    """Cached: the world, every free-space map and every door or model change ask again."""
-    return tuple(build_parts(object_type, np.asarray(size), variant, facing, prefab))
+           prefab: str) -> tuple[tuple[Mesh, ...], np.ndarray]:
+    """The parts and their bounds, cached: the world, every free-space map and every door or model
+    change ask again."""
+    parts = tuple(build_parts(object_type, np.asarray(size), variant, facing, prefab))
+    return parts, np.array([part.bounds() for part in parts])
+
+
+@functools.lru_cache(maxsize=8192)
+def _facing(center: tuple[float, float], yaw: float, size: tuple[float, float, float],
+            walls: tuple, front: str) -> int:
+    """Cached :func:`choose_facing`: every free-space map asks again for every object."""
+    return choose_facing(center, yaw, size, walls, front=front)
