@@ -154,6 +154,34 @@ def test_furniture_blocks(houses):
                 assert raw.data[r, c] == OCCUPIED, obj.id
 
 
+def _inside_box(grid: Grid, obj, margin: float) -> np.ndarray:
+    """Cells whose centre lies in ``obj``'s default box shrunk by ``margin`` on every side."""
+    box = obj.box(None)
+    xs, ys = grid.cell_centres()
+    c, s = math.cos(obj.yaw), math.sin(obj.yaw)
+    u = (xs - box.position[0]) * c + (ys - box.position[1]) * s
+    v = -(xs - box.position[0]) * s + (ys - box.position[1]) * c
+    return (np.abs(u) <= box.size[0] / 2 - margin) & (np.abs(v) <= box.size[1] / 2 - margin)
+
+
+def test_parts_block_not_boxes(houses):
+    """The map blocks the furniture parts a robot would touch, not their boxes: the empty corner of
+    a corner sofa is free floor; a dining table blocks a tall robot with its top, a short robot that
+    fits under the top only with its legs."""
+    house = houses[1]
+    sofa = house.object("Sofa_1")                              # 'Corner Sofa', 2.66 x 1.92 m
+    raw = obstacles(dataclasses.replace(house, objects=(sofa,)), {})
+    inside = _inside_box(raw, sofa, 0.05)
+    free = (raw.data[inside] == FREE).mean()
+    assert 0.15 < free < 0.6, free
+    table = next(o for o in houses[15].objects if o.type == "Table" and o.size[2] > 0.6)
+    alone = dataclasses.replace(houses[15], objects=(table,))
+    tall, short = obstacles(alone, {}, height=1.6), obstacles(alone, {}, height=0.5)
+    inside = _inside_box(tall, table, 0.05)
+    assert (tall.data[inside] == OCCUPIED).all()
+    assert (short.data[inside] == OCCUPIED).mean() < 0.3
+
+
 def test_objects_out_of_reach_do_not_block(houses):
     """Lights, windows, doors' own objects and the station change nothing; a short robot passes
     under a wall cabinet that blocks a tall one."""

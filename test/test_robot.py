@@ -14,6 +14,7 @@ import pybullet as pb
 import pytest
 
 from ravh_sim.cli import main as cli_main
+from ravh_sim.errors import UserError
 from ravh_sim.nav.follower import FollowerConfig, PathFollower, Status, Track, drive, steer
 from ravh_sim.nav.grid import FREE, OCCUPIED, Grid
 from ravh_sim.nav.mapio import read_map
@@ -23,7 +24,9 @@ from ravh_sim.paths import ROBOTS_DIR
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.robot.robot import Odometry, Robot, relative, wrap_angle
 from ravh_sim.robot.simulation import Simulation
-from ravh_sim.world.scene import DOOR_LEAF_THICKNESS, World
+from ravh_sim.world.footprint import make_footprint
+from ravh_sim.world.scene import World
+from ravh_sim.world.solids import DOOR_LEAF_THICKNESS, object_parts
 from ravh_sim.world.settings import AgentSpec, resolve
 
 GIRAFF = load_profile("giraff")
@@ -79,8 +82,19 @@ def wall_rects(house) -> list[Rect]:
 
 
 def door_leaf_rect(door) -> Rect:
-    """The closed leaf's collision box (the World makes it twice the drawn leaf's thickness)."""
-    return door.position[:2], (door.leaf[0], 2 * DOOR_LEAF_THICKNESS), door.yaw
+    """The closed leaf's box: the drawn leaf model's width and thickness."""
+    return door.position[:2], (door.leaf[0], DOOR_LEAF_THICKNESS), door.yaw
+
+
+def part_rects(world: World, obj_id: str) -> list[Rect]:
+    """The floor rectangles of an object's model parts (a closed door: its leaf) that a robot can
+    touch: the surfaces it stops at (a door slab or a closet's fronts lie inside their box)."""
+    obj = world.house.object(obj_id)
+    floor = world.house.room(obj.room).floor_z
+    if obj_id in world.house.door_by_id:
+        floor = min(world.house.room(r).floor_z for r in world.house.door_by_id[obj_id].rooms)
+    placed = object_parts(world.house, obj, world.settings.models[obj_id])
+    return list(placed.footprints(floor + 0.02, floor + GIRAFF.height))
 
 
 def object_rect(world, obj) -> Rect:
@@ -148,7 +162,8 @@ def test_full_speed_into_a_closed_door_stops_at_the_leaf(make_world):
     assert found, "no open door in house 15 with a clear approach"
     pose, (nx, ny) = found
     world.set_door_open(door.id, False)
-    distances, robot = ram(world, pose, seconds=1.0 / VMAX + 4.0, watch=[leaf, *wall_rects(world.house)])
+    distances, robot = ram(world, pose, seconds=1.0 / VMAX + 4.0,
+                           watch=[*part_rects(world, door.id), *wall_rects(world.house)])
     assert min(distances) >= R - SINK
     to_leaf = rect_distance(robot.pose[:2], leaf)
     assert to_leaf <= R + TOUCH, "never reached the door"
@@ -167,7 +182,7 @@ def test_full_speed_into_furniture_stops_at_it(make_world, kind):
                 break
     assert found, f"no {kind} with a clear approach in house 15"
     pose, (nx, ny) = found
-    distances, robot = ram(world, pose, seconds=1.0 / VMAX + 4.0, watch=[rect])
+    distances, robot = ram(world, pose, seconds=1.0 / VMAX + 4.0, watch=part_rects(world, obj.id))
     assert min(distances) >= R - SINK, f"sank {R - min(distances):.3f} m into {obj.id}"
     assert distances[-1] <= R + TOUCH, f"never reached {obj.id}"
     assert (robot.pose[0] - rect[0][0]) * nx + (robot.pose[1] - rect[0][1]) * ny > 0
@@ -186,6 +201,27 @@ def test_a_start_overlapping_a_wall_is_pushed_out_and_stays_put(make_world):
     assert math.dist(start[:2], station) < 0.15
     sim.step(240)
     assert math.dist(robot.pose[:2], start[:2]) < 1e-3
+    recorded = world.settings.agents[0].pose                   # the footprint says where it started
+    assert recorded[:2] == pytest.approx(start[:2], abs=1e-4) and recorded[:2] != pytest.approx(station)
+    assert make_footprint(world.house, world.settings)["settings"]["agents"][0]["pose"] == list(recorded)
+
+
+def test_a_start_inside_furniture_is_refused_naming_the_nearest_free_pose(make_world):
+    """House 15: a start wedged between the shower and the basin cannot be pushed clear; it is
+    refused, and the pose the error names is one where the robot starts clear and stays."""
+    asked = (-0.25, 0.95, 0.0)
+    with pytest.raises(UserError, match=r"'robot': start pose \[-0.25, 0.95, 0.0\] is inside an obstacle; "
+                                        r"nearest free pose: \[") as refused:
+        Simulation(make_world(15, [AgentSpec("robot", "giraff", asked)]))
+    named = str(refused.value).split("nearest free pose: [")[1].rstrip("]")
+    suggested = tuple(float(v) for v in named.split(","))
+    world = make_world(15, [AgentSpec("robot", "giraff", suggested)])
+    sim = Simulation(world)
+    robot = sim.robot("robot")
+    assert math.dist(suggested[:2], asked[:2]) < 1.0                # the bathroom is cramped
+    assert robot.is_clear() and world.settings.agents[0].pose == suggested
+    sim.step(240)
+    assert math.dist(robot.pose[:2], suggested[:2]) < 1e-3
 
 
 # --------------------------------------------------------------------------- limits and commands

@@ -3,12 +3,16 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pybullet as pb
 import pytest
 from conftest import resolved
 
-from ravh_sim.world.footprint import build_instances
+from ravh_sim.world.footprint import build_instances, make_footprint
+from ravh_sim.world.furniture import variant_count
+from ravh_sim.world.mesh import Mesh
 from ravh_sim.world.scene import World
+from ravh_sim.world.solids import object_parts
 
 
 def test_every_house_builds_with_one_body_per_labelled_object(houses):
@@ -82,3 +86,25 @@ def test_model_swap_rebuilds_the_body(houses):
 def test_gl_or_fallback_renderer_is_reported(houses):
     with World(houses[20], resolved(houses[20])) as world:
         assert world.renderer in ("gl", "tiny")
+
+
+def test_every_variant_of_every_object_lies_in_its_footprint_box(houses):
+    """The footprint's box of an object (position, size, yaw) contains the model the world draws and
+    collides with, for every object of every house and every model variant."""
+    checked = 0
+    for n, house in houses.items():
+        settings = resolved(house)
+        for variant in range(max(variant_count(o.type) for o in house.objects)):
+            settings.models = {o.id: variant for o in house.objects}
+            rows = {r["name"]: r for r in make_footprint(house, settings)["instances"]}
+            for obj in house.objects:
+                row, placed = rows[obj.id], object_parts(house, obj, variant)
+                if obj.id in house.door_by_id:
+                    continue                        # the leaf in the doorway, not an upstream box
+                lo, hi = Mesh.merged(placed.parts).bounds()
+                assert placed.position == pytest.approx(row["position"], abs=1e-4), (n, obj.id, variant)
+                assert placed.yaw == pytest.approx(row["yaw"], abs=1e-4), (n, obj.id, variant)
+                half = np.asarray(row["size"]) / 2 + 1e-4
+                assert (-half <= lo).all() and (hi <= half).all(), (n, obj.id, variant, lo, hi, row["size"])
+                checked += 1
+    assert checked > 3000

@@ -4,8 +4,11 @@ The map is computed from the house model, not sensed, so navigation works from t
 agrees with the pybullet world by construction. Three steps, each its own function:
 
 1. :func:`obstacles` rasterises the house at one robot height: the union of the room floors (plus
-   open doorways) is the known area, everything else is UNKNOWN; wall pieces, columns, closed door
-   leaves and furniture footprints that the robot's body would hit are OCCUPIED; the rest is FREE.
+   open doorways) is the known area, everything else is UNKNOWN; wall pieces and door jambs as the
+   world builds them (:func:`ravh_sim.world.structure.solid_walls`), columns, closed door
+   leaves and the furniture parts that the robot's body would hit (legs, seats, a table top below
+   the robot's height: :mod:`ravh_sim.world.solids`, the parts the world collides with) are
+   OCCUPIED; the rest is FREE.
 2. :func:`inflate` grows every non-free cell by the robot radius (a disc), so a FREE cell is a
    position where the whole robot disc fits: the planner can then treat the robot as a point.
 3. :func:`free_space` chains the two; :func:`distance_to_obstacle` gives the clearance the planner
@@ -32,14 +35,16 @@ import numpy as np
 from ravh_sim.errors import UnknownNameError
 from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid
 from ravh_sim.world.geometry import box_corners
-from ravh_sim.world.house import Door, House, HouseObject, Wall
+from ravh_sim.world.house import Door, House, Wall
+from ravh_sim.world.solids import Footprint, object_parts
+from ravh_sim.world.structure import solid_walls
 
 NON_OBSTACLE_TYPES = frozenset({"Door", "Wall", "Light", "Station"})
 """Object types that never block: doors (handled through ``house.doors``), windows (inside the
 walls), ceiling lights and the robot's own charging station."""
 
 MIN_OBSTACLE_TOP = 0.02
-"""Objects whose top is at most this high above the floor (rugs, thresholds) do not block."""
+"""Parts whose top is at most this high above the floor (rugs, thresholds) do not block."""
 
 MIN_DOOR_THICKNESS = 0.1
 _SHIFT = 8                                  # cv2 fixed-point fraction bits
@@ -79,7 +84,7 @@ def obstacles(house: House, door_open: Mapping[str, bool], models: Mapping[str, 
         if open_state[door.id]:
             _fill_box(known, _door_box(door), grid)
     blocked = np.zeros(grid.shape, np.uint8)
-    for box in _obstacle_boxes(house, open_state, models, height):
+    for box in _obstacle_boxes(house, open_state, models, height, resolution):
         _fill_box(blocked, box, grid)
     grid.data[known > 0] = FREE
     grid.data[blocked > 0] = OCCUPIED
@@ -107,15 +112,16 @@ def distance_to_obstacle(grid: Grid) -> np.ndarray:
 
 # --------------------------------------------------------------------------- shapes
 
-Box = tuple[tuple[float, float], tuple[float, float], float]
+Box = Footprint
 """A yawed rectangle on the floor: centre (x, y), size (along yaw, across), yaw."""
 
 
 def _obstacle_boxes(house: House, open_state: Mapping[str, bool], models: Mapping[str, int],
-                    height: float) -> Iterator[Box]:
-    """Footprints of everything that blocks a robot of ``height``."""
+                    height: float, resolution: float = 0.0) -> Iterator[Box]:
+    """Footprints of everything that blocks a robot of ``height``; object parts thinner than
+    ``resolution`` grow to it inside their object (see ``Placed.footprints``)."""
     floor_z = {room.id: room.floor_z for room in house.rooms}
-    for wall in house.walls:
+    for wall in (w for room in house.rooms for w in solid_walls(house, room.id)):
         base = floor_z[wall.room]
         if wall.z0 < base + height and wall.z1 > base:
             yield _wall_box(wall)
@@ -123,9 +129,10 @@ def _obstacle_boxes(house: House, open_state: Mapping[str, bool], models: Mappin
         if not open_state[door.id]:
             yield _door_box(door)
     for obj in house.objects:
-        box = _object_box(obj, models.get(obj.id), floor_z[obj.room], height)
-        if box is not None:
-            yield box
+        if obj.type not in NON_OBSTACLE_TYPES:
+            base = floor_z[obj.room]
+            placed = object_parts(house, obj, models.get(obj.id))
+            yield from placed.footprints(base + MIN_OBSTACLE_TOP, base + height, resolution)
 
 
 def _wall_box(wall: Wall) -> Box:
@@ -136,17 +143,6 @@ def _wall_box(wall: Wall) -> Box:
 def _door_box(door: Door) -> Box:
     """The doorway rectangle: the frame's width along ``yaw``, at least the leaf's thickness deep."""
     return door.position[:2], (door.width, max(door.leaf[1], MIN_DOOR_THICKNESS)), door.yaw
-
-
-def _object_box(obj: HouseObject, model: int | None, floor_z: float, height: float) -> Box | None:
-    """The footprint of ``obj``'s model box, or None when it cannot touch the robot's body."""
-    if obj.type in NON_OBSTACLE_TYPES:
-        return None
-    box = obj.box(model)
-    bottom, top = box.position[2] - box.size[2] / 2, box.position[2] + box.size[2] / 2
-    if top <= floor_z + MIN_OBSTACLE_TOP or bottom >= floor_z + height:
-        return None
-    return box.position[:2], box.size[:2], obj.yaw
 
 
 # --------------------------------------------------------------------------- raster

@@ -239,6 +239,10 @@ class Robot:
         self._command: tuple[float, float] = (0.0, 0.0)
         self._read_state()
 
+    def is_clear(self) -> bool:
+        """Whether the body overlaps nothing (beyond PLACE_TOLERANCE) where it stands."""
+        return self._deepest_overlap() is None
+
     def _deepest_overlap(self) -> tuple[float, float] | None:
         """The horizontal move that clears the deepest overlap of the body, or None if it is
         clear of everything (within PLACE_TOLERANCE)."""

@@ -2,12 +2,12 @@
 
 Rays go out from the laser height in a few ``rayTestBatch`` calls of growing length (see
 :meth:`Laser._trace`). Ranges follow REP 117: +inf where nothing is hit within ``range_max``, -inf
-where the hit is closer than ``range_min``. The robot's own body must not shadow the scan, but a
-batch cannot skip bodies: rays whose first hit is an ignored body are cast again from where they
-leave that body's bounding box. (Rays that start inside a convex body never hit it, so a body
-around the laser needs no ignoring; a bumper or mast in front of it does.) Open doors are moved out
-of the house by the World, so the laser sees through open doorways; closed doors, walls and
-furniture stop it. Noise is Gaussian, seeded from the world seed and a scan counter.
+where the hit is closer than ``range_min``. The robot's own body must not shadow the scan: ignored
+bodies sit in collision groups that the rays' mask leaves out (:meth:`World.ray_mask`), so no ray
+ever hits them, wherever it starts (a ray starting inside a convex body may or may not hit it).
+Open doors are moved out of the house by the World, so the laser sees through open doorways;
+closed doors, walls and furniture parts (legs, not their bounding boxes) stop it. Noise is
+Gaussian, seeded from the world seed and a scan counter.
 """
 from __future__ import annotations
 
@@ -25,8 +25,6 @@ from ravh_sim.world.scene import World
 NOISE_STREAM = 2            # noise generator stream of lasers (cameras use another)
 STAGES = (1.5, 4.0, 10.0)   # m: ray lengths of the first cast stages (then range_max)
 STAGE_OVERLAP = 0.01        # m: a stage starts this much before the previous one ended
-RECAST_GAP = 1e-3           # m beyond an ignored body's box where a re-cast ray starts
-MAX_RECASTS = 8             # per stage: ignored bodies a ray may pass
 
 
 @dataclass
@@ -69,7 +67,7 @@ class Laser:
         z = (floor_at(self.world, x, y) if floor_z is None else floor_z) + spec.height
         directions = np.stack([np.cos(self.angles + yaw), np.sin(self.angles + yaw),
                                np.zeros(len(self.angles))], axis=1)
-        bodies, distances = self._trace(np.array([x, y, z]), directions, set(ignore_bodies))
+        bodies, distances = self._trace(np.array([x, y, z]), directions, self.world.ray_mask(ignore_bodies))
         ranges = distances.astype(np.float32)
         if spec.noise_sigma > 0:
             rng = np.random.default_rng([self.world.settings.seed, NOISE_STREAM, self.count])
@@ -82,48 +80,26 @@ class Laser:
         self.count += 1
         return scan
 
-    def _trace(self, origin: np.ndarray, directions: np.ndarray, ignore: set[int]
-               ) -> tuple[np.ndarray, np.ndarray]:
-        """(first body hit or -1, its distance or +inf) per ray, skipping ``ignore`` bodies.
+    def _trace(self, origin: np.ndarray, directions: np.ndarray, mask: int) -> tuple[np.ndarray, np.ndarray]:
+        """(first body hit or -1, its distance or +inf) per ray, among bodies that ``mask`` sees.
 
         Bullet's ray test walks every bounding box a ray crosses over its whole length, so a scan
         is cast in growing stages (STAGES, then range_max): a ray that hits something stops, the
         others go on from where they ended. Indoors most rays stop in the first stages, which
-        halves the cost of one full-length batch. A ray that hits an ignored body starts again
-        just past that body's bounding box.
+        halves the cost of one full-length batch.
         """
         n = len(directions)
         bodies, distances = np.full(n, -1, np.int64), np.full(n, np.inf)
-        start = np.zeros(n)                                  # where each ray (re)starts, metres
-        todo = np.arange(n)
-        ends = [e for e in STAGES if e < self.spec.range_max] + [self.spec.range_max]
-        for end in ends:
-            go = todo
-            for _ in range(MAX_RECASTS):
-                go = go[start[go] < end]
-                if not go.size:
-                    break
-                hits = pb.rayTestBatch(origin + directions[go] * start[go, None],
-                                       origin + directions[go] * end, physicsClientId=self.world.client)
-                body = np.fromiter((h[0] for h in hits), np.int64, len(hits))
-                point = np.array([h[3] for h in hits])
-                skip = np.isin(body, list(ignore)) if ignore else np.zeros(len(go), bool)
-                found = (body >= 0) & ~skip
-                bodies[go[found]] = body[found]
-                distances[go[found]] = np.einsum("ij,ij->i", point[found] - origin, directions[go[found]])
-                start[go[body < 0]] = end - STAGE_OVERLAP          # goes on in the next stage
-                for i in np.flatnonzero(skip):
-                    aabb = pb.getAABB(int(body[i]), physicsClientId=self.world.client)
-                    start[go[i]] = _box_exit(origin, directions[go[i]], aabb) + RECAST_GAP
-                todo = todo[~np.isin(todo, go[found])]
-                go = go[skip]                                     # again, past the ignored body
+        todo, start = np.arange(n), 0.0
+        for end in [e for e in STAGES if e < self.spec.range_max] + [self.spec.range_max]:
+            hits = pb.rayTestBatch(origin + directions[todo] * start, origin + directions[todo] * end,
+                                   collisionFilterMask=mask, physicsClientId=self.world.client)
+            body = np.fromiter((h[0] for h in hits), np.int64, len(hits))
+            found = body >= 0
+            point = np.array([h[3] for h in hits])[found]
+            bodies[todo[found]] = body[found]
+            distances[todo[found]] = np.einsum("ij,ij->i", point - origin, directions[todo[found]])
+            todo, start = todo[~found], end - STAGE_OVERLAP
+            if not todo.size:
+                break
         return bodies, distances
-
-
-def _box_exit(origin: np.ndarray, direction: np.ndarray, aabb) -> float:
-    """Distance along a ray from ``origin`` to where it leaves an axis-aligned box (slab method)."""
-    lo, hi = np.asarray(aabb[0]), np.asarray(aabb[1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t1, t2 = (lo - origin) / direction, (hi - origin) / direction
-    far = np.where(direction != 0, np.maximum(t1, t2), np.inf)
-    return float(max(far.min(), 0.0))

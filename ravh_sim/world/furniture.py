@@ -1368,14 +1368,26 @@ def build_model(object_type: str, size: Sequence[float], variant: int, facing: i
     a wardrobe's doors on its long side) turn a quarter when ``facing`` does
     not suit the box.
     """
+    return Mesh.merged(build_parts(object_type, size, variant, facing, prefab))
+
+
+def build_parts(object_type: str, size: Sequence[float], variant: int, facing: int = 0,
+                prefab: str = '') -> Parts:
+    """The parts ``build_model`` merges (same arguments, same placement in the box), one by one.
+
+    Every part is a convex solid (a box, prism, bevelled box or icosahedron), so physics can
+    collide with each part as its own convex hull: legs with gaps between them, an L-shaped sofa
+    with a free corner, exactly the surfaces the camera sees.
+    """
     spec = _SPECS.get(object_type, _GENERIC)
     extents = _clean_size(size)
     facing = int(facing) % 4
     if not suits_box(spec.front, extents, facing):
         facing = (facing + 1) % 4
     d, w, h = extents[[0, 1, 2] if facing % 2 == 0 else [1, 0, 2]]
-    mesh = Mesh.merged(spec.build(d, w, h, int(variant) % spec.variants, prefab or ''))
-    return _fit(mesh, (d, w, h)).transformed(facing * np.pi / 2)
+    parts = spec.build(d, w, h, int(variant) % spec.variants, prefab or '')
+    lo, hi = Mesh.merged(parts).bounds()
+    return [_fit(part, lo, hi, (d, w, h)).transformed(facing * np.pi / 2) for part in parts]
 
 
 def _clean_size(size: Sequence[float]) -> np.ndarray:
@@ -1383,8 +1395,8 @@ def _clean_size(size: Sequence[float]) -> np.ndarray:
     return np.maximum(np.where(np.isfinite(values), values, MIN_EXTENT), MIN_EXTENT)
 
 
-def _fit(mesh: Mesh, size: Sequence[float]) -> Mesh:
-    """Map the mesh's bounding box exactly onto a box of ``size`` centred at the origin."""
-    lo, hi = mesh.bounds()
+def _fit(part: Mesh, lo: np.ndarray, hi: np.ndarray, size: Sequence[float]) -> Mesh:
+    """Map ``part`` as the box between ``lo`` and ``hi`` (the whole model's bounds) maps exactly
+    onto a box of ``size`` centred at the origin."""
     scale = np.asarray(size, np.float64) / np.maximum(hi - lo, 1e-12)
-    return Mesh((mesh.vertices - (lo + hi) / 2) * scale, mesh.faces, mesh.colours)
+    return Mesh((part.vertices - (lo + hi) / 2) * scale, part.faces, part.colours)

@@ -256,3 +256,18 @@ def ellipsoid(center: Vec3, size: Vec3, colour: int) -> Mesh:
     """Icosahedron stretched to fill ``size`` (20 triangles): foliage, globes."""
     unit = _ICOSAHEDRON / _ICOSAHEDRON.max(axis=0)
     return _convex(unit * np.abs(np.asarray(size, np.float64)) / 2, _ICOSAHEDRON_FACES, center, colour)
+
+
+def hulls_obj_text(parts: Sequence[Mesh]) -> str:
+    """OBJ text with one object per part (positions and faces only) for a collision shape.
+
+    pybullet loads such a file as a compound of one convex hull per object, which is exactly the
+    part when the part is convex (as every primitive here is).
+    """
+    lines, offset = [f'# ravh_sim collision parts: {len(parts)} convex hulls'], 1
+    for i, part in enumerate(parts):
+        lines.append(f'o part{i}')
+        lines += ['v %.5f %.5f %.5f' % tuple(v) for v in _clean(part.vertices, 5)]
+        lines += ['f %d %d %d' % tuple(f) for f in part.faces + offset]
+        offset += len(part.vertices)
+    return '\n'.join(lines) + '\n'

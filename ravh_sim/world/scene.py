@@ -20,7 +20,7 @@ import os
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterator
+from typing import Iterable, Iterator
 
 import cv2
 import numpy as np
@@ -28,18 +28,20 @@ import pybullet as pb
 
 from ravh_sim.render.backend import resolve_backend
 from ravh_sim.world import paints
-from ravh_sim.world.facing import choose_facing
 from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances
-from ravh_sim.world.furniture import build_model, front_axis
-from ravh_sim.world.mesh import Mesh
 from ravh_sim.world.geometry import quaternion_from_yaw
-from ravh_sim.world.house import Door, House, HouseObject, Wall
+from ravh_sim.world.house import House, HouseObject, Wall
+from ravh_sim.world.mesh import Mesh, hulls_obj_text
 from ravh_sim.world.palette import PALETTE
 from ravh_sim.world.settings import Resolved
-from ravh_sim.world.structure import TexturedMesh, floor_mesh, wall_mesh
+from ravh_sim.world.solids import Placed, door_pose, object_parts
+from ravh_sim.world.structure import TexturedMesh, floor_mesh, solid_walls, wall_mesh
 
 NON_SOLID_TYPES = frozenset({"Station"})      # drawn, but the robot starts on it
-DOOR_LEAF_THICKNESS = 0.05
+OPEN_DOOR_DROP = 50.0                          # m an open door's leaf sinks, out of every sensor's view
+OWN_GROUP_BITS = range(8, 31)                  # collision group bits for bodies hidden from rays (the
+                                               # lower ones are Bullet's default, static, ... groups)
+ALL_GROUPS = -1
 CEILING_PAINT = "white"
 GROUND_HALF_SIZE = 60.0
 
@@ -83,6 +85,7 @@ class World:
         self._by_name: dict[str, Instance] = {}
         self.triangle_count = 0
         self._looks: list[tuple[int, int, list[float]]] = []
+        self._ray_groups: dict[int, int] = {}
         self._building = True
         self.floor_z = float(np.median([r.floor_z for r in house.rooms]))
         self._build()
@@ -112,6 +115,26 @@ class World:
             lut[inst.body] = inst.id
         return lut
 
+    def ray_mask(self, hidden: Iterable[int] = ()) -> int:
+        """The ``collisionFilterMask`` of a ray test that sees every body except ``hidden`` ones.
+
+        Bullet's ray tests cannot skip bodies, only collision groups outside their mask: the first
+        time a body is hidden it gets a group bit of its own on every link (its mask stays 'all',
+        so its contacts do not change). A robot's laser thus never sees its own body, wherever its
+        beams start, while every other robot's laser does.
+        """
+        mask = ALL_GROUPS
+        for body in hidden:
+            if body not in self._ray_groups:
+                if len(self._ray_groups) == len(OWN_GROUP_BITS):
+                    raise RuntimeError(f"at most {len(OWN_GROUP_BITS)} bodies can be hidden from rays")
+                group = 1 << OWN_GROUP_BITS[len(self._ray_groups)]
+                for link in range(-1, pb.getNumJoints(body, physicsClientId=self.client)):
+                    pb.setCollisionFilterGroupMask(body, link, group, ALL_GROUPS, physicsClientId=self.client)
+                self._ray_groups[body] = group
+            mask &= ~self._ray_groups[body]
+        return mask
+
     # ------------------------------------------------------------------ building
     def _build(self) -> None:
         # The ground: a thin slab just under the floors (the robot drives on it; it also shows as the
@@ -138,7 +161,7 @@ class World:
     def _structure_body(self, inst: Instance) -> int:
         room = self.house.room(inst.room)
         if inst.kind == "walls":
-            walls = [w for w in self.house.walls if w.room == room.id]
+            walls = solid_walls(self.house, room.id)
             body = self._mesh_body(wall_mesh(walls, self.house.windows), self._wall_collision(walls), "walls")
             self._apply_paint(body, self.settings.paint[room.id]["walls"])
         elif inst.kind == "floor":
@@ -161,36 +184,23 @@ class World:
                                             collisionFrameOrientations=orn, physicsClientId=self.client)
 
     def _object_body(self, obj: HouseObject, model: int) -> int:
-        if obj.id in self.house.door_by_id:
-            return self._door_body(self.house.door_by_id[obj.id], model)
-        box = obj.box(model)
-        walls = [(w.a, w.b) for w in self.house.walls if w.room == obj.room and w.kind != "lintel"]
-        facing = choose_facing(box.position[:2], obj.yaw, box.size, walls, front=front_axis(obj.type))
-        mesh = build_model(obj.type, box.size, model, facing=facing, prefab=obj.prefab)
-        collision = -1
-        if obj.type not in NON_SOLID_TYPES:
-            collision = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[max(s / 2, 0.005) for s in box.size],
-                                                physicsClientId=self.client)
-        return self._palette_body(mesh, collision, box.position, obj.yaw)
-
-    def _door_body(self, door: Door, model: int) -> int:
-        """The door leaf: a slab across the doorway, moved out of the house when the door is open."""
-        width, _, height = door.leaf
-        size = (DOOR_LEAF_THICKNESS, width, height)
-        mesh = build_model("Door", size, model)
-        collision = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[0.05, width / 2, height / 2],
-                                            physicsClientId=self.client)
-        floor = min(self.house.room(r).floor_z for r in door.rooms)
-        pos = (door.position[0], door.position[1], floor + height / 2)
-        return self._palette_body(mesh, collision, pos, door.yaw - math.pi / 2)
-
-    def _palette_body(self, mesh: Mesh, collision: int, position, yaw: float) -> int:
+        """The object's model, colliding part by part (see :mod:`ravh_sim.world.solids`); a door is
+        its leaf, which :meth:`set_door_open` then puts in the doorway or out of the house."""
+        placed = object_parts(self.house, obj, model)
+        collision = -1 if obj.type in NON_SOLID_TYPES else self._parts_collision(placed)
+        mesh = placed.mesh()
         path = self._asset(mesh_bytes(mesh), ".obj", lambda p: mesh.write_obj(p, PALETTE))
-        body = self._file_body(path, collision, position, yaw)
+        body = self._file_body(path, collision, placed.position, placed.yaw)
         self._set_look(body, self._texture("palette"), [1, 1, 1, 1])
         self.visuals[body] = Visual(mesh=mesh)
         self.triangle_count += mesh.triangle_count
         return body
+
+    def _parts_collision(self, placed: Placed) -> int:
+        """A compound of one convex hull per model part, loaded from a cached OBJ file."""
+        text = hulls_obj_text(placed.parts)
+        path = self._asset(text.encode(), ".obj", lambda p: p.write_text(text))
+        return pb.createCollisionShape(pb.GEOM_MESH, fileName=str(path), physicsClientId=self.client)
 
     def _mesh_body(self, mesh: TexturedMesh, collision: int, surface: str) -> int:
         key = np.concatenate([mesh.vertices.ravel(), mesh.uvs.ravel()]).round(4).tobytes()
@@ -254,13 +264,9 @@ class World:
     # ------------------------------------------------------------------ run-time changes
     def set_door_open(self, door_id: str, is_open: bool) -> None:
         """Open (leaf out of the house, as upstream hides it) or close (leaf in the doorway) a door."""
-        door = self.house.door_by_id[door_id]
-        inst = self._by_name[door_id]
-        floor = min(self.house.room(r).floor_z for r in door.rooms)
-        z = floor + door.leaf[2] / 2 if not is_open else floor - 50.0
-        pb.resetBasePositionAndOrientation(inst.body, [door.position[0], door.position[1], z],
-                                           quaternion_from_yaw(door.yaw - math.pi / 2),
-                                           physicsClientId=self.client)
+        (x, y, z), yaw = door_pose(self.house, self.house.door_by_id[door_id])
+        pb.resetBasePositionAndOrientation(self._by_name[door_id].body, [x, y, z - OPEN_DOOR_DROP * is_open],
+                                           quaternion_from_yaw(yaw), physicsClientId=self.client)
         self.settings.doors[door_id] = is_open
         self.revision += 1
 

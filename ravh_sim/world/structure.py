@@ -3,20 +3,87 @@
 Unlike furniture (coloured through the palette texture), structure is painted: a plain colour or a
 tiling texture, so its UVs run in world metres divided by the texture's tile size and the renderer
 repeats the texture. Flat normals, one OBJ per room and surface. Walls have openings where windows
-are.
+are (drawn only: the collision walls stay whole).
+
+The wall pieces built (:func:`solid_walls`, drawn, collided with and mapped alike) close the cracks
+that the upstream pieces leave at doorways: a lintel stops a few millimetres short of the wall
+pieces beside it, a door leaf is narrower than its gap in the walls, and walls end exactly at the
+floor and the ceiling, which let the sky or the ground show through thin slits. Lintels reach into
+their neighbours, door jambs fill the gap between a leaf's edges and the wall ends, and walls reach
+through the floor and the ceiling.
 """
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from ravh_sim.world.geometry import triangulate
-from ravh_sim.world.house import Room, Wall, Window
+from ravh_sim.world.house import Door, House, Room, Wall, Window
 from ravh_sim.world.paints import TEXTURE_TILE_M
+
+
+LINTEL_OVERLAP = 0.05      # m a lintel reaches into the wall pieces at each of its ends
+SEAM_OVERLAP = 0.05        # m a wall piece reaching the floor (ceiling) goes below (above) it: no seam
+JAMB_REACH = 0.1           # m beyond a doorway's frame where the wall ends beside it are looked for
+
+
+def solid_walls(house: House, room_id: str) -> list[Wall]:
+    """The wall pieces built for a room: its walls and the jambs of the doors whose first room it is
+    (each door's jambs are built once), reaching through the floor and the ceiling where they meet
+    them, and its lintels lengthened into their neighbours."""
+    room = house.room(room_id)
+    pieces = [w for w in house.walls if w.room == room_id]
+    pieces += [j for door in house.doors if door.rooms[0] == room_id for j in door_jambs(house, door)]
+    walls = []
+    for w in pieces:
+        if w.kind == "lintel":
+            w = _lengthened(w, LINTEL_OVERLAP)
+        if w.z0 <= room.floor_z + 1e-3:
+            w = replace(w, z0=room.floor_z - SEAM_OVERLAP)
+        if w.z1 >= room.ceiling_z - 1e-3:
+            w = replace(w, z1=room.ceiling_z + SEAM_OVERLAP)
+        walls.append(w)
+    return walls
+
+
+def door_jambs(house: House, door: Door) -> list[Wall]:
+    """Pieces from a door leaf's edges to the ends of the wall pieces beside the doorway (none where
+    the walls reach the leaf), through the doorway's whole depth, as high as the doorway."""
+    ux, uy = math.cos(door.yaw), math.sin(door.yaw)
+    nx, ny = -uy, ux
+    cx, cy = door.position[:2]
+    floor = min(house.room(r).floor_z for r in door.rooms)
+    half_leaf, half_frame = door.leaf[0] / 2, door.width / 2
+    left, right = -half_leaf, half_leaf                 # wall ends beside the doorway, along ``yaw``
+    for w in house.walls:
+        if w.kind == "lintel" or w.room not in door.rooms or w.z0 > floor + door.leaf[2]:
+            continue
+        ends = [((x - cx) * ux + (y - cy) * uy, (x - cx) * nx + (y - cy) * ny) for x, y in (w.a, w.b)]
+        if any(abs(across) > (door.thickness + w.thickness) / 2 for _, across in ends):
+            continue                                    # not a wall of this doorway
+        lo, hi = sorted(along for along, _ in ends)
+        if -half_frame - JAMB_REACH <= hi <= -half_leaf:
+            left = min(left, hi)
+        if half_leaf <= lo <= half_frame + JAMB_REACH:
+            right = max(right, lo)
+    top = floor + door.leaf[2]
+    jambs = []
+    for a, b in ((left, -half_leaf), (half_leaf, right)):
+        if b - a > 1e-4:
+            jambs.append(Wall((cx + a * ux, cy + a * uy), (cx + b * ux, cy + b * uy), door.thickness, floor,
+                              top, door.rooms[0], "jamb"))
+    return jambs
+
+
+def _lengthened(w: Wall, by: float) -> Wall:
+    (ax, ay), (bx, by_) = w.a, w.b
+    length = max(w.length, 1e-9)
+    dx, dy = (bx - ax) / length * by, (by_ - ay) / length * by
+    return replace(w, a=(ax - dx, ay - dy), b=(bx + dx, by_ + dy))
 
 
 @dataclass

@@ -1,0 +1,105 @@
+"""What each object is made of where it stands: its model's parts, placed in the house.
+
+Why one place: the pybullet world draws an object as its parts merged and collides with each part
+(so the laser sees between table legs and hits a door leaf where the camera sees it), and the
+free-space map blocks the floor under the parts that a robot's body would hit (a table top blocks
+a tall robot; the empty corner of an L-shaped sofa does not). Physics, sensors and navigation then
+agree on every surface because they read the same parts.
+
+A :class:`Placed` object holds its parts in its body frame (box centre at the origin, unrotated)
+and the body's pose; the world turns it by ``yaw`` about z and moves it to ``position``.
+"""
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+
+from ravh_sim.world.facing import choose_facing
+from ravh_sim.world.furniture import build_parts, front_axis
+from ravh_sim.world.house import Door, House, HouseObject
+from ravh_sim.world.mesh import Mesh
+
+DOOR_LEAF_THICKNESS = 0.05
+"""m: the door leaf model's thickness (the doorway's frame is part of the walls)."""
+
+Footprint = tuple[tuple[float, float], tuple[float, float], float]
+"""A yawed rectangle on the floor: centre (x, y), size (along yaw, across), yaw."""
+
+
+@dataclass(frozen=True)
+class Placed:
+    """An object's model parts in its body frame and the body's pose in the house."""
+    parts: tuple[Mesh, ...]
+    bounds: np.ndarray                     # (parts, 2, 3): each part's min and max corner
+    position: tuple[float, float, float]
+    yaw: float
+
+    def mesh(self) -> Mesh:
+        """The parts merged: what the camera draws."""
+        return Mesh.merged(self.parts)
+
+    def footprints(self, z_low: float, z_high: float, min_size: float = 0.0) -> Iterator[Footprint]:
+        """Floor rectangles (in the body's yawed frame) of the parts that reach into the height
+        band (z_low, z_high) of the house frame: a part's rectangle is its extent along the body's
+        axes, exact for the boxes most parts are and a little larger for round or slanted ones.
+
+        A rectangle narrower than ``min_size`` grows to it towards the middle of the object, so a
+        raster that draws thin shapes as lines one cell wide never draws beyond the object.
+        """
+        x, y, z = self.position
+        lo, hi = self.bounds[:, 0], self.bounds[:, 1]
+        reach = (hi[:, 2] + z > z_low) & (lo[:, 2] + z < z_high)
+        lo, hi = lo[reach, :2], hi[reach, :2]
+        half = np.maximum(hi - lo, min_size) / 2
+        whole_lo, whole_hi = self.bounds[:, 0, :2].min(axis=0), self.bounds[:, 1, :2].max(axis=0)
+        middle = np.clip((lo + hi) / 2, np.minimum(whole_lo + half, 0.0), np.maximum(whole_hi - half, 0.0))
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        for (mx, my), (hx, hy) in zip(middle.tolist(), half.tolist()):
+            yield (x + c * mx - s * my, y + s * mx + c * my), (2 * hx, 2 * hy), self.yaw
+
+
+def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
+    """``obj`` as model variant ``model`` shows it (doors: the leaf, closed, see :func:`door_parts`)."""
+    if obj.id in house.door_by_id:
+        return door_parts(house, house.door_by_id[obj.id], model)
+    box = obj.box(model)
+    walls = tuple((w.a, w.b) for w in house.walls if w.room == obj.room and w.kind != "lintel")
+    facing = _facing(tuple(box.position[:2]), obj.yaw, tuple(box.size), walls, front_axis(obj.type))
+    variant = obj.default_model if model is None else model
+    parts, bounds = _parts(obj.type, tuple(box.size), variant, facing, obj.prefab)
+    return Placed(parts, bounds, tuple(box.position), obj.yaw)
+
+
+def door_parts(house: House, door: Door, model: int | None) -> Placed:
+    """The closed door leaf (see :func:`door_pose`)."""
+    width, _, height = door.leaf
+    variant = house.object(door.id).default_model if model is None else model
+    parts, bounds = _parts("Door", (DOOR_LEAF_THICKNESS, width, height), variant, 0, "")
+    return Placed(parts, bounds, *door_pose(house, door))
+
+
+def door_pose(house: House, door: Door) -> tuple[tuple[float, float, float], float]:
+    """Where a closed door's leaf stands: across the doorway on the lower of its rooms' floors,
+    its thickness along the doorway's depth (body position, yaw)."""
+    floor = min(house.room(r).floor_z for r in door.rooms)
+    return (door.position[0], door.position[1], floor + door.leaf[2] / 2), door.yaw - math.pi / 2
+
+
+@functools.lru_cache(maxsize=8192)
+def _parts(object_type: str, size: tuple[float, float, float], variant: int, facing: int,
+           prefab: str) -> tuple[tuple[Mesh, ...], np.ndarray]:
+    """The parts and their bounds, cached: the world, every free-space map and every door or model
+    change ask again."""
+    parts = tuple(build_parts(object_type, np.asarray(size), variant, facing, prefab))
+    return parts, np.array([part.bounds() for part in parts])
+
+
+@functools.lru_cache(maxsize=8192)
+def _facing(center: tuple[float, float], yaw: float, size: tuple[float, float, float],
+            walls: tuple, front: str) -> int:
+    """Cached :func:`choose_facing`: every free-space map asks again for every object."""
+    return choose_facing(center, yaw, size, walls, front=front)
