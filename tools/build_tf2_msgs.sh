@@ -2,6 +2,7 @@
 # Build and install tools/tf2_msgs (TFMessage only; same type hash as Jazzy's tf2_msgs) into a venv
 # made of the ROS 2 wheels, which ship no tf2_msgs. Does nothing when tf2_msgs already imports.
 # Usage: tools/build_tf2_msgs.sh VENV. Needs cmake and g++ (Debian: apt-get install cmake g++).
+# tools/tf2_msgs/COLCON_IGNORE keeps colcon (full ROS installs, which have tf2_msgs) from building it.
 # Installing into the venv prefix puts the Python package in site-packages and the libraries in
 # VENV/lib, which the wheels' bootstrapper already puts on LD_LIBRARY_PATH: no env vars at run time.
 set -euo pipefail
