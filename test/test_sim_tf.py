@@ -215,3 +215,14 @@ def test_parameters_are_read_only(sim):
     watcher.node.destroy_client(client)
     result = future.result().results[0]
     assert not result.successful and "read-only" in result.reason
+
+
+def test_a_bad_map_tf_is_a_one_line_error():
+    import subprocess
+    import sys
+
+    from rosgraph import ros_env
+    out = subprocess.run([sys.executable, "-m", "ravh_sim.cli", "sim", "--house", "20", "--ros-args", "-p",
+                          "map_tf:=bogus"], capture_output=True, text=True, env=ros_env(), timeout=120)
+    assert out.returncode == 2 and "map_tf must be one of auto, on, off, got 'bogus'" in out.stderr
+    assert "Traceback" not in out.stderr

@@ -200,7 +200,6 @@ class SimNode(Node):
         return t
 
     def _publish_latched(self) -> None:
-        rt = self.runtime
         footprint = self._publish_footprint()
         labels = {str(row["id"]): {"name": row["name"], "kind": row["kind"], "type": row["type"],
                                    "tags": row["tags"], "room": row["room"], "mask_color": row["mask_color"]}
