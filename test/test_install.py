@@ -47,3 +47,16 @@ def test_tf2_msgs_has_the_official_jazzy_type_hash():
                          env=dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST"))
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == JAZZY_TFMESSAGE_HASH
+
+
+def test_package_xml_declares_every_ros_package_the_code_imports():
+    import re
+    import xml.etree.ElementTree as ET
+    root = Path(__file__).resolve().parents[1]
+    declared = {e.text for e in ET.parse(root / "package.xml").getroot().iter("exec_depend")}
+    imported = set()
+    for source in [*(root / "ravh_sim").rglob("*.py"), *(root / "ravh_msgs_py").rglob("*.py")]:
+        imported |= set(re.findall(r"^\s*(?:from|import) (rclpy|\w+_(?:msgs|srvs|interfaces))\b", source.read_text(),
+                                   re.MULTILINE))
+    assert {"tf2_msgs", "diagnostic_msgs", "rclpy"} <= imported
+    assert imported <= declared, imported - declared

@@ -81,12 +81,3 @@ def test_laser_endpoints_land_on_occupied_cells(houses):
     finally:
         rt.close()
 
-
-def test_map_files_default_to_the_obstacle_map(houses, tmp_path):
-    from ravh_sim.nav.mapio import read_map
-    house = houses[20]
-    nav = Navigation(house, resolved(house), load_profile("giraff"))
-    _, plain = nav.write_map(tmp_path / "plain")
-    _, inflated = nav.write_map(tmp_path / "inflated", inflated=True)
-    assert (read_map(plain).data == nav.obstacle_map().data).all()
-    assert (read_map(inflated).data == nav.map().data).all()
