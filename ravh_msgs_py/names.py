@@ -4,6 +4,18 @@ The sim node, the behaviours, the recorder, the tests and users' code import the
 spelling strings, so a rename happens here once. With several agents, robot topics and frames are
 prefixed by the agent name (``robot2/scan``, ``robot2/base_link``); the first agent uses the plain
 names so single-robot users see the conventional ``/scan`` and ``base_link``.
+
+Per agent (``robot2`` here; the first agent drops the prefix): frames ``robot2/odom``,
+``robot2/base_link``, ``robot2/laser_link``, ``robot2/camera_link``, ``robot2/camera_optical_frame``
+under the one shared ``map``; topics ``robot2/scan``, ``robot2/odom``, ``robot2/cmd_vel``,
+``robot2/camera/...`` and service ``robot2/capture``. /clock, /tf, /tf_static, /map and the /ravh/
+services are shared.
+
+The ``map`` frame is the house model's x, y; its z=0 is the floor the robots drive on (the house
+model's main floor level, which the model itself puts at z=-0.03: ground-truth JSON such as
+/ravh/ground_truth and query answers keep the model's z, so subtract the floor's ``floor_z`` to
+place them in ``map``). base_link lies on the floor (z=0), sensor frames above it at their mount
+heights.
 """
 from __future__ import annotations
 
@@ -32,10 +44,12 @@ MAP_TO_ODOM = "map_to_odom"                        # geometry_msgs/TransformStam
 ROOM = "ravh/room"                                 # std_msgs/String: the room the robot is in
 CMD_VEL = "cmd_vel"                                # geometry_msgs/Twist (or TwistStamped by parameter)
 CAPTURE_EVENT = "ravh/capture"                     # std_msgs/String JSON: a capture was published
-MAP = "/map"                                       # nav_msgs/OccupancyGrid, latched
+MAP = "/map"                                       # nav_msgs/OccupancyGrid, latched: obstacle map at laser height
+FREE_SPACE_MAP = "/ravh/free_space"                # nav_msgs/OccupancyGrid, latched: FREE where the robot's centre fits
 GROUND_TRUTH = "/ravh/ground_truth"                # std_msgs/String JSON footprint, latched
-TF = "/tf"                                         # tf2_msgs/TFMessage (when tf2_msgs exists)
-TF_STATIC = "/tf_static"                           # tf2_msgs/TFMessage, latched
+TF = "/tf"                                         # tf2_msgs/TFMessage: odom -> base_link, map -> odom (see map_tf)
+TF_STATIC = "/tf_static"                           # tf2_msgs/TFMessage, latched: every agent's sensor mounts
+TF_STATIC_TOPIC = "tf_static/{child}"              # geometry_msgs/TransformStamped, latched: one mount each
 
 # ---------------------------------------------------------------- services
 # JSON services use diagnostic_msgs/srv/AddDiagnostics, the one standard service shaped
@@ -43,7 +57,8 @@ TF_STATIC = "/tf_static"                           # tf2_msgs/TFMessage, latched
 # response.success says ok and response.message carries the JSON reply.
 QUERY_SERVICE = "/ravh/query"                      # ground-truth query language (ravh_msgs_py.query)
 APPEARANCE_SERVICE = "/ravh/appearance"            # appearance changes (ravh_msgs_py.appearance)
-GET_MAP_SERVICE = "/ravh/get_map"                  # nav_msgs/srv/GetMap
+GET_MAP_SERVICE = "/ravh/get_map"                  # nav_msgs/srv/GetMap: the obstacle map (/map)
+GET_FREE_SPACE_SERVICE = "/ravh/get_free_space"    # nav_msgs/srv/GetMap: the inflated free space
 GET_PLAN_SERVICE = "/ravh/get_plan"                # nav_msgs/srv/GetPlan
 CAPTURE_SERVICE = "capture"                        # std_srvs/srv/Trigger: one synchronised capture now
 RESET_SERVICE = "/ravh/reset"                      # std_srvs/srv/Trigger: agents back to their start

@@ -121,7 +121,7 @@ def cmd_map(args: argparse.Namespace) -> int:
         settings["doors"] = {"all": args.doors, "set": {}}
     resolved = resolve(settings, house, args.seed, str(args.config or "config/default.yaml"))
     profile = load_profile(args.profile or (resolved.agents[0].profile if resolved.agents else "giraff"))
-    pgm, yaml_path = Navigation(house, resolved, profile, args.resolution).write_map(args.output)
+    pgm, yaml_path = Navigation(house, resolved, profile, args.resolution).write_map(args.output, args.inflated)
     print(f"wrote {pgm} and {yaml_path}")
     return 0
 
@@ -242,12 +242,14 @@ def _parser() -> argparse.ArgumentParser:
                    help="overlay a planned path between two points")
     p.set_defaults(func=cmd_plan)
 
-    p = sub.add_parser("map", help="write the robot's free-space map (ROS map_server PGM + YAML)")
+    p = sub.add_parser("map", help="write the house's obstacle map, as the sim's /map (ROS map_server PGM + YAML)")
     _world_args(p)
     p.add_argument("--doors", choices=("open", "closed", "random", "default"), default=None,
                    help="every door's state (default: as the config says)")
     p.add_argument("--resolution", type=_positive, default=0.05, help="metres per cell (default 0.05)")
     p.add_argument("--profile", default=None, help="robot profile (default: the first agent's)")
+    p.add_argument("--inflated", action="store_true",
+                   help="write the robot's inflated free space instead (where its centre may go)")
     p.add_argument("-o", "--output", type=Path, required=True, help="folder for map.pgm and map.yaml")
     p.set_defaults(func=cmd_map)
 

@@ -365,6 +365,11 @@ def test_recorder_writes_captures_and_a_bag(sim, tmp_path):
             assert counts["/" + topic] == 4, topic
         assert counts[n.MAP] >= 1 and counts[n.GROUND_TRUTH] >= 1 and counts["/" + n.INSTANCE_LABELS] == 1
         assert counts["/" + n.SCAN] >= 4 and counts["/" + n.ODOM] > 0 and counts["/" + n.GROUND_TRUTH_POSE] > 0
+        assert counts[n.TF] > 0 and counts[n.TF_STATIC] == 1
+        static_conn = [c for c in bag.connections if c.topic == n.TF_STATIC]
+        static = [typestore.deserialize_cdr(raw, c.msgtype) for c, _, raw in bag.messages(connections=static_conn)]
+        assert {t.child_frame_id for t in static[0].transforms} == {n.LASER_FRAME, n.CAMERA_FRAME,
+                                                                    n.CAMERA_OPTICAL_FRAME}
         latched = next(c for c in bag.connections if c.topic == n.MAP)
         assert latched.ext.offered_qos_profiles[0].durability.name == "TRANSIENT_LOCAL"
         depth_conn = [c for c in bag.connections if c.topic == "/" + n.DEPTH_IMAGE]

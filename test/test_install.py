@@ -32,3 +32,31 @@ def test_installed_package_finds_its_data(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path,
                          env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"})
     assert out.returncode == 0 and Path(out.stdout.strip()) == PREFIX / "share/ravh_sim/houses"
+
+
+JAZZY_TFMESSAGE_HASH = "RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087"
+
+
+def test_tf2_msgs_has_the_official_jazzy_type_hash():
+    """tools/setup.sh builds tf2_msgs when the install has none; its TFMessage must be the wire type
+    every ROS tool expects (the hash is what DDS endpoints compare)."""
+    code = ("import rclpy; from tf2_msgs.msg import TFMessage; rclpy.init(); n = rclpy.create_node('hash');"
+            "n.create_publisher(TFMessage, '/tf_hash_probe', 1);"
+            "print(n.get_publishers_info_by_topic('/tf_hash_probe')[0].topic_type_hash)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                         env=dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST"))
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == JAZZY_TFMESSAGE_HASH
+
+
+def test_package_xml_declares_every_ros_package_the_code_imports():
+    import re
+    import xml.etree.ElementTree as ET
+    root = Path(__file__).resolve().parents[1]
+    declared = {e.text for e in ET.parse(root / "package.xml").getroot().iter("exec_depend")}
+    imported = set()
+    for source in [*(root / "ravh_sim").rglob("*.py"), *(root / "ravh_msgs_py").rglob("*.py")]:
+        imported |= set(re.findall(r"^\s*(?:from|import) (rclpy|\w+_(?:msgs|srvs|interfaces))\b", source.read_text(),
+                                   re.MULTILINE))
+    assert {"tf2_msgs", "diagnostic_msgs", "rclpy"} <= imported
+    assert imported <= declared, imported - declared

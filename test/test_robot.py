@@ -617,9 +617,11 @@ def test_follower_fails_with_a_reason_when_the_only_door_closes_on_its_way(make_
 def test_map_files_match_the_navigation_map(make_world, tmp_path):
     world = make_world(20)
     nav = Navigation(world.house, world.settings, GIRAFF)
-    nav.write_map(tmp_path)
-    loaded = read_map(tmp_path / "map.yaml")
-    assert np.array_equal(loaded.data, nav.map().data) and loaded.origin == pytest.approx(nav.map().origin)
+    nav.write_map(tmp_path / "obstacles")
+    nav.write_map(tmp_path / "free", inflated=True)
+    for folder, grid in (("obstacles", nav.obstacle_map()), ("free", nav.map())):
+        loaded = read_map(tmp_path / folder / "map.yaml")
+        assert np.array_equal(loaded.data, grid.data) and loaded.origin == pytest.approx(grid.origin)
 
 
 def test_cli_map_writes_map_server_files_with_the_chosen_doors(tmp_path, houses):
@@ -630,6 +632,9 @@ def test_cli_map_writes_map_server_files_with_the_chosen_doors(tmp_path, houses)
     assert closed.resolution == 0.1 and opened.resolution == 0.05
     assert closed.data[closed.cell_of(*door.position[:2])] == OCCUPIED
     assert opened.data[opened.cell_of(*door.position[:2])] == FREE
+    assert cli_main(["map", "20", "--doors", "open", "--inflated", "-o", str(tmp_path / "i")]) == 0
+    inflated = read_map(tmp_path / "i" / "map.yaml")
+    assert (inflated.data == FREE).sum() < 0.7 * (opened.data == FREE).sum()      # the robot's radius off every wall
     with pytest.raises(SystemExit):
         cli_main(["map", "20", "--resolution", "0", "-o", str(tmp_path / "x")])
 

@@ -204,7 +204,7 @@ def test_client_helper(sim):
 
 def test_get_plan_stays_in_free_space(sim):
     _, probe = sim
-    grid_msg = probe.call(GetMap, n.GET_MAP_SERVICE, GetMap.Request()).map
+    grid_msg = probe.call(GetMap, n.GET_FREE_SPACE_SERVICE, GetMap.Request()).map
     grid = Grid(np.array(grid_msg.data, np.int8).reshape(grid_msg.info.height, grid_msg.info.width),
                 (grid_msg.info.origin.position.x, grid_msg.info.origin.position.y), grid_msg.info.resolution)
     free = np.argwhere(grid.data == FREE)

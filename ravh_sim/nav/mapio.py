@@ -1,7 +1,8 @@
 """Occupancy maps on disk in the ROS map_server format (a PGM picture plus a YAML description).
 
-Writing the free-space map this way lets the ROS 2 side (nav2 map_server, RViz) load exactly the
-map the simulator plans on, and lets users inspect or hand-edit it with any picture editor.
+Writing the maps this way lets the ROS 2 side (nav2 map_server, RViz) load exactly the sim's /map
+(the obstacle map) or the free space it plans on, and lets users inspect or hand-edit them with any
+picture editor.
 
 Format (trinary mode): P5 PGM, 254 free, 0 occupied, 205 unknown; image row 0 is the highest y (a
 picture is drawn top-down, the grid counts rows from the lowest y). The YAML says where the picture
@@ -35,7 +36,7 @@ def write_map(grid: Grid, directory: str | Path, name: str = "map") -> tuple[Pat
     pixels[grid.data == FREE] = FREE_PIXEL
     pixels[grid.data == OCCUPIED] = OCCUPIED_PIXEL
     rows, cols = grid.shape
-    header = f"P5\n# ravh_sim free space, {grid.resolution} m/cell\n{cols} {rows}\n255\n".encode()
+    header = f"P5\n# ravh_sim map, {grid.resolution} m/cell\n{cols} {rows}\n255\n".encode()
     pgm_path.write_bytes(header + pixels[::-1].tobytes())
     description = {
         "image": pgm_path.name,

@@ -1,4 +1,8 @@
-"""The Navigation Manager: the free-space map of a house as it is now, and paths over it.
+"""The Navigation Manager: the maps of a house as it is now, and paths over it.
+
+Two maps: :meth:`Navigation.map` is the robot's inflated free space (where its centre may go: what
+the planner and behaviours use), :meth:`Navigation.obstacle_map` the uninflated obstacle map at laser
+height (what a ROS map_server would load: the sim's /map).
 
 It watches the settings a World changes at run time (doors, object models) rather than the World
 itself, so the same object serves the simulator (pass ``world.house, world.settings``: the World
@@ -8,6 +12,7 @@ rebuilt only when a door or a model differs from what it was built from.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path as FilePath
 
 import numpy as np
@@ -15,6 +20,7 @@ import numpy as np
 from ravh_sim.nav.freespace import distance_to_obstacle, free_space
 from ravh_sim.nav.grid import FREE, Grid, reachable
 from ravh_sim.nav.mapio import write_map
+from ravh_sim.nav.obstaclemap import obstacle_map
 from ravh_sim.nav.planner import Path, Point, Unreachable, densify, plan_path
 from ravh_sim.robot.profile import RobotProfile
 from ravh_sim.world.house import House
@@ -25,22 +31,34 @@ START_SNAP = 0.3                 # m, as the planner: a start on the inflation u
 
 
 class Navigation:
-    """Free-space map and planner for one robot profile (its radius and height shape the map)."""
+    """Maps and planner for one robot profile (its radius, height and laser height shape the maps)."""
 
     def __init__(self, house: House, settings: Resolved, profile: RobotProfile,
                  resolution: float = DEFAULT_RESOLUTION) -> None:
         self.house, self.settings, self.profile, self.resolution = house, settings, profile, resolution
         self._built_from: tuple[dict[str, bool], dict[str, int]] | None = None
-        self._grid: Grid | None = None
+        self._grids: dict[str, Grid] = {}
 
     def map(self) -> Grid:
-        """The free-space grid for the current doors and models (the same object until they change)."""
+        """The inflated free-space grid for the current doors and models (the same object until they
+        change): FREE where the robot's centre may go."""
+        return self._current("free_space", lambda doors, models: free_space(
+            self.house, doors, models, radius=self.profile.radius, height=self.profile.height,
+            resolution=self.resolution))
+
+    def obstacle_map(self) -> Grid:
+        """The uninflated obstacle map at laser height for the current doors and models."""
+        return self._current("obstacles", lambda doors, models: obstacle_map(
+            self.house, doors, models, self.profile.laser.height, self.resolution))
+
+    def _current(self, kind: str, build: Callable[[dict, dict], Grid]) -> Grid:
+        """The cached grid of ``kind``, rebuilt when a door or a model changed since it was built."""
         state = (dict(self.settings.doors), dict(self.settings.models))
-        if self._grid is None or state != self._built_from:
-            self._grid = free_space(self.house, state[0], state[1], radius=self.profile.radius,
-                                    height=self.profile.height, resolution=self.resolution)
-            self._built_from = state
-        return self._grid
+        if state != self._built_from:
+            self._grids, self._built_from = {}, state
+        if kind not in self._grids:
+            self._grids[kind] = build(*state)
+        return self._grids[kind]
 
     def closed_doors(self) -> list[str]:
         return [door for door, is_open in self.settings.doors.items() if not is_open]
@@ -92,6 +110,7 @@ class Navigation:
             raise Unreachable("goal", f"room {room_id} has no free point{where}")
         return grid.center_of(int(r), int(c))
 
-    def write_map(self, directory: str | FilePath) -> tuple[FilePath, FilePath]:
-        """``map.pgm`` and ``map.yaml`` (ROS map_server format) of the current map."""
-        return write_map(self.map(), directory)
+    def write_map(self, directory: str | FilePath, inflated: bool = False) -> tuple[FilePath, FilePath]:
+        """``map.pgm`` and ``map.yaml`` (ROS map_server format) of the current obstacle map, or of the
+        robot's inflated free space with ``inflated``."""
+        return write_map(self.map() if inflated else self.obstacle_map(), directory)

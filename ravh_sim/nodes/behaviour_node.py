@@ -63,11 +63,11 @@ class RosRobot:
 
 
 class RosNavigation:
-    """The map from /map (latched, republished when doors change) and plans on it."""
+    """The robot's free space from /ravh/free_space (latched, republished when doors change) and plans on it."""
 
     def __init__(self, node: Node) -> None:
         self.grid: Grid | None = None
-        node.create_subscription(OccupancyGrid, n.MAP, self._on_map, LATCHED_QOS)
+        node.create_subscription(OccupancyGrid, n.FREE_SPACE_MAP, self._on_map, LATCHED_QOS)
 
     def _on_map(self, msg: OccupancyGrid) -> None:
         data = np.array(msg.data, dtype=np.int8).reshape(msg.info.height, msg.info.width)

@@ -9,8 +9,8 @@ A capture is the set of messages that share the stamp of a ``ravh/capture`` even
 instances, camera_infos and the scan. Events and images arrive on different topics in any order, so
 parts wait by stamp in :class:`StampMatcher` until the set is complete; periodic camera frames never
 get an event and are dropped unrecorded. The bag keeps the continuous streams (scan, odom,
-ground-truth pose, capture events) whole, the latched ones (/map, /ravh/ground_truth, instance
-labels) with transient-local QoS so ``ros2 bag play`` re-latches them, and of the camera only the
+ground-truth pose, capture events, /tf) whole, the latched ones (/map, /tf_static, /ravh/ground_truth,
+instance labels) with transient-local QoS so ``ros2 bag play`` re-latches them, and of the camera only the
 captures (JPEG colour, depth, instances, camera_infos), so bag and dataset describe the same frames.
 Bag times are sim receive times (``use_sim_time``); messages that arrive before the first /clock are
 written at the first clock time. SIGINT closes the bag (metadata.yaml written); a SIGKILLed recorder
@@ -41,6 +41,7 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 from sensor_msgs.msg import CameraInfo, CompressedImage, Image, LaserScan
 from std_msgs.msg import String
+from tf2_msgs.msg import TFMessage
 
 from ravh_msgs_py import names as n
 from ravh_sim.dataset import layout
@@ -81,7 +82,10 @@ LATCHED: dict[str, tuple[type, bool]] = {
     n.GROUND_TRUTH: (String, True),
     n.MAP: (OccupancyGrid, True),
     n.INSTANCE_LABELS: (String, False),
+    n.TF_STATIC: (TFMessage, False),
 }
+# Continuous, not per agent: name -> message type, for the bag only.
+STREAMS: dict[str, type] = {n.TF: TFMessage}
 
 
 def type_name(msg_type: type) -> str:
@@ -229,6 +233,11 @@ class RecorderNode(Node):
                 if self.bag:
                     self.bag.add_topic(sub.topic_name, msg_type, latched=True)
                 self.topics[topic] = sub.topic_name
+        for topic, msg_type in STREAMS.items() if self.bag else ():
+            sub = self.create_subscription(msg_type, topic, lambda d, t=topic: self._on_stream(t, d), STATE_QOS,
+                                           raw=True)
+            self.bag.add_topic(sub.topic_name, msg_type, latched=False)
+            self.topics[topic] = sub.topic_name
         self.log.info(f"waiting for {n.GROUND_TRUTH} to learn the house and its agents")
 
     # ------------------------------------------------------------------ set-up once the world is known
@@ -265,6 +274,9 @@ class RecorderNode(Node):
                 self._start(footprint)
         elif topic == n.MAP:
             self._submit(self.writer.write_map, grid_of(deserialize_message(data, OccupancyGrid)))
+
+    def _on_stream(self, topic: str, data: bytes) -> None:
+        self.bag.write(self.topics[topic], self._now_ns(), data)
 
     def _on_part(self, key: str, data: bytes) -> None:
         now_ns, part = self._now_ns(), self.parts[key]

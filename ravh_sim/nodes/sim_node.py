@@ -2,7 +2,12 @@
 
 ``ros2 run ravh_sim sim --house 15`` (or ``ravh sim --house 15``). The node is the clock: it advances
 physics so that sim time follows wall time times the real-time factor (0 = as fast as possible),
-publishes /clock, and stamps everything with sim time. All names come from ``ravh_msgs_py.names``.
+publishes /clock, and stamps everything with sim time, never ahead of the /clock it has published.
+All names come from ``ravh_msgs_py.names``. Parameters are read-only (they shape the world at start-up).
+
+``map_tf`` (auto|on|off) says who owns the map -> odom edge on /tf: ``on`` the sim (ground truth),
+``off`` someone else, ``auto`` (default) the sim only while no other node (slam_toolbox, AMCL)
+publishes that edge. The ground truth stays on ``map_to_odom`` and ``ground_truth/pose`` either way.
 Requests never take it down: bad commands are refused with a throttled warning, bad service
 requests get an error reply.
 """
@@ -12,41 +17,45 @@ import argparse
 import json
 import math
 import time
-from typing import Any
+from collections import deque
+from typing import Any, Callable
 
 from diagnostic_msgs.srv import AddDiagnostics
 from geometry_msgs.msg import PoseStamped, TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import OccupancyGrid, Odometry
 from nav_msgs.srv import GetMap, GetPlan
+from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, CompressedImage, Image, LaserScan
 from std_msgs.msg import String
 from std_srvs.srv import Trigger
+from tf2_msgs.msg import TFMessage
 
 from ravh_msgs_py import names as n
 from ravh_sim.errors import UserError
-from ravh_sim.render.backend import BACKENDS
+from ravh_sim.nav.grid import Grid
 from ravh_sim.nodes import convert
 from ravh_sim.nodes.common import COMMAND_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, quiet_after_shutdown, run_node
+from ravh_sim.render.backend import BACKENDS
 from ravh_sim.runtime import Agent, Rates, SimRuntime
 from ravh_sim.sensors.imaging import encode_jpeg
-
-try:                                    # every full ROS install has tf2_msgs; the PyPI wheels do not
-    from tf2_msgs.msg import TFMessage
-except ImportError:                     # pragma: no cover - depends on the install
-    TFMessage = None
 
 TICK_S = 0.005                          # wall period of the stepping timer
 MAX_STEP_S = 0.1                        # sim time advanced per tick at most (keeps services responsive)
 CMD_TIMEOUT_S = 0.5                     # stop a robot whose commands stop arriving (sim seconds)
 WARN_THROTTLE_S = 2.0
+MAP_TF_MODES = ("auto", "on", "off")
+MAP_TF_RESUME_S = 2.0                   # wall s without another map -> odom publisher before the sim takes over
+# Listening for other map -> odom publishers: best effort matches reliable and best-effort publishers.
+TF_LISTEN_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT)
 
 PARAMETERS: dict[str, Any] = {
     "house": 15, "seed": -1, "config": "", "footprint": "", "renderer": "auto", "real_time_factor": 1.0,
     "camera_rate": 10.0, "scan_rate": 10.0, "odom_rate": 50.0, "clock_rate": 100.0,
-    "cmd_vel_stamped": False,
+    "cmd_vel_stamped": False, "map_tf": "auto",
 }
 
 
@@ -54,10 +63,14 @@ class SimNode(Node):
     def __init__(self, overrides: dict[str, Any] | None = None) -> None:
         params = [Parameter(k, value=v) for k, v in (overrides or {}).items()]
         super().__init__("ravh_sim", parameter_overrides=params)
-        p = {k: self.declare_parameter(k, v).value for k, v in PARAMETERS.items()}
+        read_only = ParameterDescriptor(read_only=True)
+        p = {k: self.declare_parameter(k, v, read_only).value for k, v in PARAMETERS.items()}
         self.rtf = float(p["real_time_factor"])
         if not math.isfinite(self.rtf) or self.rtf < 0:
             raise UserError(f"real_time_factor must be >= 0 (0 = as fast as possible), got {self.rtf}")
+        self.map_tf = str(p["map_tf"])
+        if self.map_tf not in MAP_TF_MODES:
+            raise UserError(f"map_tf must be one of {', '.join(MAP_TF_MODES)}, got {self.map_tf!r}")
         self.runtime = SimRuntime(int(p["house"]), p["config"] or None, None if p["seed"] < 0 else int(p["seed"]),
                                   renderer=p["renderer"],
                                   rates=Rates(p["camera_rate"], p["scan_rate"], p["odom_rate"], p["clock_rate"]),
@@ -74,6 +87,12 @@ class SimNode(Node):
         self._last_cmd: dict[str, float] = {}
         self._wall0, self._sim0 = time.monotonic(), rt.time
         self._next_clock = 0.0
+        self._clock_sent = -math.inf
+        self._own_map_odom: deque[tuple] = deque(maxlen=256)      # what this node put on /tf lately
+        self._foreign_map_odom: dict[str, float] = {}              # odom frame -> wall time last seen
+        self._publishing_map_tf = {agent.name: self.map_tf != "off" for agent in rt.agents}
+        if self.map_tf == "auto":
+            self.create_subscription(TFMessage, n.TF, self._on_tf, TF_LISTEN_QOS)
         self._publish_latched()
         self.timer = self.create_timer(TICK_S, self._tick)
 
@@ -82,10 +101,11 @@ class SimNode(Node):
         pub = self.create_publisher
         self.clock_pub = pub(Clock, n.CLOCK, STATE_QOS)
         self.map_pub = pub(OccupancyGrid, n.MAP, LATCHED_QOS)
+        self.free_space_pub = pub(OccupancyGrid, n.FREE_SPACE_MAP, LATCHED_QOS)
         self.footprint_pub = pub(String, n.GROUND_TRUTH, LATCHED_QOS)
         self.labels_pub = pub(String, n.INSTANCE_LABELS, LATCHED_QOS)
-        self.tf_pub = pub(TFMessage, n.TF, STATE_QOS) if TFMessage else None
-        self.tf_static_pub = pub(TFMessage, n.TF_STATIC, LATCHED_QOS) if TFMessage else None
+        self.tf_pub = pub(TFMessage, n.TF, STATE_QOS)
+        self.tf_static_pub = pub(TFMessage, n.TF_STATIC, LATCHED_QOS)
         self.agent_pubs: dict[str, dict[str, Any]] = {}
         for agent in self.runtime.agents:
             def name(base: str, a: Agent = agent) -> str:
@@ -104,7 +124,7 @@ class SimNode(Node):
                 "map_odom": pub(TransformStamped, name(n.MAP_TO_ODOM), STATE_QOS),
                 "room": pub(String, name(n.ROOM), LATCHED_QOS),
                 "capture": pub(String, name(n.CAPTURE_EVENT), STATE_QOS),
-                "static": {child: pub(TransformStamped, name(f"tf_static/{child}"), LATCHED_QOS)
+                "static": {child: pub(TransformStamped, name(n.TF_STATIC_TOPIC.format(child=child)), LATCHED_QOS)
                            for child in (n.LASER_FRAME, n.CAMERA_FRAME, n.CAMERA_OPTICAL_FRAME)},
                 "last_room": None,
             }
@@ -122,7 +142,8 @@ class SimNode(Node):
         srv = self.create_service
         srv(AddDiagnostics, n.QUERY_SERVICE, self._on_query)
         srv(AddDiagnostics, n.APPEARANCE_SERVICE, self._on_appearance)
-        srv(GetMap, n.GET_MAP_SERVICE, self._on_get_map)
+        srv(GetMap, n.GET_MAP_SERVICE, lambda req, res: self._on_get_map(res, self.runtime.navigation.obstacle_map))
+        srv(GetMap, n.GET_FREE_SPACE_SERVICE, lambda req, res: self._on_get_map(res, self.runtime.navigation.map))
         srv(GetPlan, n.GET_PLAN_SERVICE, self._on_get_plan)
         srv(Trigger, n.RESET_SERVICE, self._on_reset)
         for agent in self.runtime.agents:
@@ -157,7 +178,7 @@ class SimNode(Node):
     def _publish_due(self) -> None:
         rt = self.runtime
         if rt.time + 1e-9 >= self._next_clock:
-            self.clock_pub.publish(convert.clock(rt.time))
+            self._now()
             self._next_clock += 1.0 / max(rt.rates.clock, 1e-3)
         if rt.map_version != self._published_map:
             self._publish_map()
@@ -170,22 +191,32 @@ class SimNode(Node):
                 self._publish_capture(agent)
 
     # ------------------------------------------------------------------ publishing
+    def _now(self) -> float:
+        """The sim time to stamp with, announced on /clock first if it is not yet: a stamp ahead of
+        the clock subscribers have cannot be transformed on arrival (tf2 would extrapolate)."""
+        t = self.runtime.time
+        if t > self._clock_sent:
+            self.clock_pub.publish(convert.clock(t))
+            self._clock_sent = t
+        return t
+
     def _publish_latched(self) -> None:
-        rt = self.runtime
         footprint = self._publish_footprint()
         labels = {str(row["id"]): {"name": row["name"], "kind": row["kind"], "type": row["type"],
                                    "tags": row["tags"], "room": row["room"], "mask_color": row["mask_color"]}
                   for row in footprint["instances"]}
         self.labels_pub.publish(String(data=json.dumps(labels)))
         self._publish_map()
-        for agent in rt.agents:
-            self._publish_static(agent)
+        self._publish_static()
 
     def _publish_map(self) -> None:
+        """/map (the obstacle map) and /ravh/free_space (the robot's inflated free space)."""
         rt = self.runtime
         self._published_map = rt.map_version
-        self.map_pub.publish(convert.occupancy_grid(rt.navigation.map(), convert.header(rt.time, n.MAP_FRAME),
-                                                    rt.time))
+        t = self._now()
+        for publisher, grid in ((self.map_pub, rt.navigation.obstacle_map()),
+                                (self.free_space_pub, rt.navigation.map())):
+            publisher.publish(convert.occupancy_grid(grid, convert.header(t, n.MAP_FRAME), t))
 
     def _publish_footprint(self) -> dict[str, Any]:
         """The latched footprint: republished after every appearance change so it stays true."""
@@ -196,19 +227,22 @@ class SimNode(Node):
     def _frame(self, agent: Agent, frame: str) -> str:
         return n.agent_name(frame, agent.name, agent.first)
 
-    def _publish_static(self, agent: Agent) -> None:
-        t = self.runtime.time
-        transforms = [convert.transform(convert.header(t, self._frame(agent, parent)), self._frame(agent, child),
-                                        xyz, quat)
-                      for parent, child, xyz, quat in self.runtime.static_transforms(agent)]
-        for tf in transforms:
-            self.agent_pubs[agent.name]["static"][tf.child_frame_id.split("/")[-1]].publish(tf)
-        if self.tf_static_pub:
-            self.tf_static_pub.publish(TFMessage(transforms=transforms))
+    def _publish_static(self) -> None:
+        """Every agent's sensor mounts in one latched /tf_static message: a latched topic keeps only its
+        last message, so one message per agent would leave late joiners with the last agent's only."""
+        t = self._now()
+        transforms = []
+        for agent in self.runtime.agents:
+            for parent, child, xyz, quat in self.runtime.static_transforms(agent):
+                tf = convert.transform(convert.header(t, self._frame(agent, parent)), self._frame(agent, child),
+                                       xyz, quat)
+                self.agent_pubs[agent.name]["static"][child].publish(tf)
+                transforms.append(tf)
+        self.tf_static_pub.publish(TFMessage(transforms=transforms))
 
     def _publish_state(self, agent: Agent) -> None:
         rt, pubs = self.runtime, self.agent_pubs[agent.name]
-        t = rt.time
+        t = self._now()
         odom_pose, true_pose = agent.robot.odometry, agent.robot.pose
         v, w = agent.robot.velocity
         odom_hdr = convert.header(t, self._frame(agent, n.ODOM_FRAME))
@@ -221,8 +255,11 @@ class SimNode(Node):
                                         rt.map_to_odom(agent))
         pubs["odom_tf"].publish(odom_tf)
         pubs["map_odom"].publish(map_odom)
-        if self.tf_pub:
-            self.tf_pub.publish(TFMessage(transforms=[map_odom, odom_tf]))
+        tf = [odom_tf]
+        if self._owns_map_tf(agent):
+            tf.append(map_odom)
+            self._own_map_odom.append(_tf_key(map_odom))
+        self.tf_pub.publish(TFMessage(transforms=tf))
         room = rt.room_of(agent)
         if room != pubs["last_room"]:
             pubs["last_room"] = room
@@ -230,7 +267,7 @@ class SimNode(Node):
 
     def _publish_scan(self, agent: Agent) -> None:
         scan = self.runtime.scan(agent)
-        hdr = convert.header(self.runtime.time, self._frame(agent, n.LASER_FRAME))
+        hdr = convert.header(self._now(), self._frame(agent, n.LASER_FRAME))
         self.agent_pubs[agent.name]["scan"].publish(convert.laser_scan(
             scan.ranges, scan.angle_min, scan.angle_increment, scan.range_min, scan.range_max,
             scan.scan_time, hdr))
@@ -241,7 +278,7 @@ class SimNode(Node):
         ravh/capture (pose, room) so recorders can store it as one dataset sample."""
         rt, pubs = self.runtime, self.agent_pubs[agent.name]
         cap = rt.capture(agent)
-        hdr = convert.header(rt.time, self._frame(agent, n.CAMERA_OPTICAL_FRAME))
+        hdr = convert.header(self._now(), self._frame(agent, n.CAMERA_OPTICAL_FRAME))
         h, w = cap.rgb.shape[:2]
         info = convert.camera_info(cap.K, w, h, hdr, cap.camera_info.D)
         pubs["rgb"].publish(convert.image(cap.rgb, "rgb8", hdr))
@@ -257,6 +294,30 @@ class SimNode(Node):
             self._publish_scan(agent)
             pubs["capture"].publish(String(data=json.dumps(event)))
         return event
+
+    # ------------------------------------------------------------------ map -> odom ownership
+    def _on_tf(self, msg: TFMessage) -> None:
+        """Note map -> odom edges that this node did not publish (a SLAM or localisation node)."""
+        for tf in msg.transforms:
+            if tf.header.frame_id.lstrip("/") == n.MAP_FRAME and _tf_key(tf) not in self._own_map_odom:
+                self._foreign_map_odom[tf.child_frame_id.lstrip("/")] = time.monotonic()
+
+    def _owns_map_tf(self, agent: Agent) -> bool:
+        """Whether the sim publishes ``agent``'s map -> odom on /tf now (see ``map_tf``); logs each
+        hand-over once."""
+        if self.map_tf != "auto":
+            return self.map_tf == "on"
+        odom = self._frame(agent, n.ODOM_FRAME)
+        seen = self._foreign_map_odom.get(odom)
+        owns = seen is None or time.monotonic() - seen > MAP_TF_RESUME_S
+        if owns != self._publishing_map_tf[agent.name]:
+            self._publishing_map_tf[agent.name] = owns
+            self.get_logger().info(
+                f"map_tf auto: no other node has published {n.MAP_FRAME} -> {odom} for {MAP_TF_RESUME_S:g} s; "
+                "the sim publishes its ground truth on /tf again" if owns else
+                f"map_tf auto: another node publishes {n.MAP_FRAME} -> {odom}; the sim stops publishing "
+                f"its ground truth on /tf (still on {self._frame(agent, n.MAP_TO_ODOM)})")
+        return owns
 
     # ------------------------------------------------------------------ callbacks
     def _warn(self, text: str) -> None:
@@ -284,16 +345,16 @@ class SimNode(Node):
             self._publish_footprint()            # /map follows on the next step if doors changed
         return response
 
-    def _on_get_map(self, request: GetMap.Request, response: GetMap.Response):
-        rt = self.runtime
-        response.map = convert.occupancy_grid(rt.navigation.map(), convert.header(rt.time, n.MAP_FRAME), rt.time)
+    def _on_get_map(self, response: GetMap.Response, grid: Callable[[], Grid]):
+        t = self._now()
+        response.map = convert.occupancy_grid(grid(), convert.header(t, n.MAP_FRAME), t)
         return response
 
     def _on_get_plan(self, request: GetPlan.Request, response: GetPlan.Response):
         rt = self.runtime
         start = (request.start.pose.position.x, request.start.pose.position.y)
         goal = (request.goal.pose.position.x, request.goal.pose.position.y)
-        response.plan.header = convert.header(rt.time, n.MAP_FRAME)
+        response.plan.header = convert.header(self._now(), n.MAP_FRAME)
         if not all(math.isfinite(v) for v in (*start, *goal)):
             self._warn("GetPlan: rejected non-finite start or goal")
             return response
@@ -330,6 +391,12 @@ class SimNode(Node):
         self.runtime.close()
 
 
+def _tf_key(tf: TransformStamped) -> tuple:
+    """What tells one transform message from another (stamp, child and values)."""
+    t, r = tf.transform.translation, tf.transform.rotation
+    return (tf.child_frame_id, tf.header.stamp.sec, tf.header.stamp.nanosec, t.x, t.y, t.z, r.x, r.y, r.z, r.w)
+
+
 def parse_args(argv: list[str]) -> dict[str, Any]:
     """Command-line flags (each also a ROS parameter: ``--ros-args -p house:=15`` works too)."""
     p = argparse.ArgumentParser(prog="sim", description="ravh_sim: a Robot@VirtualHome house on ROS 2")
@@ -344,6 +411,9 @@ def parse_args(argv: list[str]) -> dict[str, Any]:
     p.add_argument("--scan-rate", dest="scan_rate", type=float)
     p.add_argument("--odom-rate", dest="odom_rate", type=float)
     p.add_argument("--cmd-vel-stamped", dest="cmd_vel_stamped", action="store_true", default=None)
+    p.add_argument("--map-tf", dest="map_tf", choices=MAP_TF_MODES,
+                   help="who publishes map -> odom on /tf: auto (default: the sim unless another node "
+                        "does), on (always the sim), off (never the sim)")
     args = p.parse_args(argv)
     return {k: v for k, v in vars(args).items() if v is not None}
 
