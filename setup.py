@@ -30,7 +30,7 @@ setup(
         *tree("houses"),
         *tree("config"),
     ],
-    install_requires=["numpy", "pybullet", "opencv-python-headless", "pyyaml", "trimesh", "rosbags"],
+    install_requires=["numpy", "pybullet", "opencv-python-headless", "pyyaml", "pydantic>=2", "trimesh", "rosbags"],
     zip_safe=True,
     maintainer="ravh_sim developers",
     description="Robot@VirtualHome for ROS 2: realistic virtual houses in pybullet",

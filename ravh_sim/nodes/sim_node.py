@@ -57,7 +57,7 @@ class SimNode(Node):
         self.rtf = float(p["real_time_factor"])
         if not math.isfinite(self.rtf) or self.rtf < 0:
             raise UserError(f"real_time_factor must be >= 0 (0 = as fast as possible), got {self.rtf}")
-        self.runtime = SimRuntime(int(p["house"]), p["config"] or None, None if p["seed"] < 0 else int(p["seed"]),
+        self.runtime = SimRuntime(int(p["house"]), p["config"] or None, None if p["seed"] == -1 else p["seed"],
                                   renderer=p["renderer"],
                                   rates=Rates(p["camera_rate"], p["scan_rate"], p["odom_rate"], p["clock_rate"]),
                                   footprint=p["footprint"] or None)
