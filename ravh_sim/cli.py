@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from collections import Counter
 from pathlib import Path
@@ -38,6 +39,9 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except KeyboardInterrupt:
         return 130
+    except BrokenPipeError:                        # `ravh houses --json | head`: the reader left
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())   # no second error at exit
+        return 141                                 # 128 + SIGPIPE, as a shell reports it
 
 
 # ---------------------------------------------------------------------------- helpers
@@ -154,6 +158,7 @@ def cmd_render(args: argparse.Namespace) -> int:
     from ravh_sim.world.appearance import Appearance
     from ravh_sim.world.scene import World
     house, resolved = _resolved(args)
+    house.room_at_or_raise(*args.pose[:2])           # an all-sky picture from outside helps nobody
     with World(house, resolved, renderer=args.renderer) as world:
         appearance = Appearance(world)
         if args.sun is not None:

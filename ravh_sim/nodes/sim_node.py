@@ -293,13 +293,13 @@ class SimNode(Node):
         start = (request.start.pose.position.x, request.start.pose.position.y)
         goal = (request.goal.pose.position.x, request.goal.pose.position.y)
         response.plan.header = convert.header(rt.time, n.MAP_FRAME)
-        if not all(math.isfinite(v) for v in (*start, *goal)):
-            self._warn("GetPlan: rejected non-finite start or goal")
-            return response
         try:
-            path = rt.navigation.plan(start, goal)
+            path = rt.plan(start, goal)
         except UserError as e:
             self._warn(f"GetPlan: {e}")
+            return response
+        except Exception as e:  # never die from a request
+            self._warn(f"GetPlan: {type(e).__name__}: {e}")
             return response
         pts = path.points
         for i, (x, y) in enumerate(pts):

@@ -19,7 +19,7 @@ from typing import Annotated, Any, Iterator, Literal
 
 from pydantic import AfterValidator, Field, model_validator
 
-from ravh_sim.errors import FileFieldError, UnknownNameError
+from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
 from ravh_sim.paths import HOUSES_DIR
 from ravh_sim.schema import Strict, number, read_text, shown, validate, vector
 from ravh_sim.world.geometry import (Polygon, distance_to_polygon, point_in_polygon, polygon_area,
@@ -184,6 +184,16 @@ class House:
             if room.contains(x, y):
                 return room
         return None
+
+    def room_at_or_raise(self, x: float, y: float) -> Room:
+        """The room at (x, y); outside every room a UserError names the nearest one."""
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise UserError(f"({x}, {y}) is not a finite position")
+        room = self.room_at(x, y)
+        if room is None:
+            raise UserError(f"({x:.3g}, {y:.3g}) is outside every room of house {self.number}; "
+                            f"nearest room: {self.nearest_room(x, y).id}")
+        return room
 
     def nearest_room(self, x: float, y: float) -> Room:
         """The room whose floor outline is closest to (x, y) (for errors about points outside)."""

@@ -18,6 +18,7 @@ from typing import Annotated, Any, Literal
 import yaml
 from pydantic import AfterValidator, Field
 
+from ravh_msgs_py.appearance import SEED_MAX
 from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
 from ravh_sim.paths import DEFAULT_CONFIG, ROBOTS_DIR
 from ravh_sim.schema import Strict, read_text, shown, validate
@@ -28,7 +29,6 @@ from ravh_sim.world.house import House
 SUN_PRESETS = {"day": 100.0, "sunset": 180.0, "night": 200.0}
 SWITCH = ("on", "off", "random")
 DOOR_STATES = ("default", "open", "closed", "random")
-SEED_MAX = 2**32 - 1       # seeds feed numpy and random streams; one range for files, flags and requests
 AGENT_CLEARANCE = 0.5      # m between two agents' start positions (two Giraff radii)
 
 
@@ -331,9 +331,10 @@ def _start_pose(value: Any, house: House, source: str, key: str) -> tuple[float,
     if value == "station":
         return (house.station.position[0], house.station.position[1], house.station.yaw)
     x, y, yaw = (float(v) for v in value)
-    if house.room_at(x, y) is None:
-        raise FileFieldError(source, key, f"({x:.3g}, {y:.3g}) is outside every room of house {house.number}; "
-                             f"nearest room: {house.nearest_room(x, y).id}")
+    try:
+        house.room_at_or_raise(x, y)
+    except UserError as e:
+        raise FileFieldError(source, key, str(e)) from None
     return (x, y, yaw)
 
 
