@@ -32,6 +32,7 @@ MAP_TO_ODOM = "map_to_odom"                        # geometry_msgs/TransformStam
 ROOM = "ravh/room"                                 # std_msgs/String: the room the robot is in
 CMD_VEL = "cmd_vel"                                # geometry_msgs/Twist (or TwistStamped by parameter)
 CAPTURE_EVENT = "ravh/capture"                     # std_msgs/String JSON: a capture was published
+CAPTURE_RECORDED = "ravh/capture_recorded"         # std_msgs/String JSON: a recorder stored a capture
 MAP = "/map"                                       # nav_msgs/OccupancyGrid, latched
 GROUND_TRUTH = "/ravh/ground_truth"                # std_msgs/String JSON footprint, latched
 TF = "/tf"                                         # tf2_msgs/TFMessage (when tf2_msgs exists)

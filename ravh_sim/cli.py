@@ -42,6 +42,9 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:                        # `ravh houses --json | head`: the reader left
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())   # no second error at exit
         return 141                                 # 128 + SIGPIPE, as a shell reports it
+    except OSError as e:                           # unwritable output, full disk: files are written atomically
+        print(f"ravh: error: {e.filename or ''}: {e.strerror or e}", file=sys.stderr)
+        return 2
 
 
 # ---------------------------------------------------------------------------- helpers
