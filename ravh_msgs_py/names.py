@@ -33,6 +33,7 @@ ROOM = "ravh/room"                                 # std_msgs/String: the room t
 CMD_VEL = "cmd_vel"                                # geometry_msgs/Twist (or TwistStamped by parameter)
 CAPTURE_EVENT = "ravh/capture"                     # std_msgs/String JSON: a capture was published
 CAPTURE_RECORDED = "ravh/capture_recorded"         # std_msgs/String JSON: a recorder stored a capture
+STEP = "ravh/step"                                  # geometry_msgs/TwistStamped: lockstep command + time granted
 MAP = "/map"                                       # nav_msgs/OccupancyGrid, latched
 GROUND_TRUTH = "/ravh/ground_truth"                # std_msgs/String JSON footprint, latched
 TF = "/tf"                                         # tf2_msgs/TFMessage (when tf2_msgs exists)

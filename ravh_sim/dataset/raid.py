@@ -7,7 +7,9 @@ set, else on one of its own so raids on one machine never hear each other (it sa
 are stopped with SIGINT in the order that loses nothing: behaviour done -> recorder (once it has every
 capture the behaviour was given, or has given up) -> sim.
 
-Nothing is lost silently: the behaviour runs with ``--wait-recorder`` (a capture counts once the
+Raids are reproducible: sim and behaviour run in lockstep (sim time advances only as the behaviour
+grants it), so the same seed gives the same captures, poses and images. Nothing is lost silently: the
+behaviour runs with ``--wait-recorder`` (a capture counts once the
 recorder confirms it), and the status is ``done`` only when the behaviour finished, every process
 exited cleanly and the dataset holds every capture the behaviour logged. The output folder must be new
 or empty; raid.json is written atomically, also after Ctrl-C, and says what happened.
@@ -95,13 +97,14 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
     sim = recorder = behaviour = None
     try:
         sim = _spawn(["sim", "--house", str(house), "--config", str(settings_path), "--rtf", str(rtf),
-                      "--camera-rate", "0"], env, logs / "sim.log")
+                      "--camera-rate", "0", "--lockstep"], env, logs / "sim.log")
         recorder = _spawn(["recorder", "--out", str(out), "--raid", json.dumps(raid_meta)], env,
                           logs / "recorder.log")
         _wait_for(lambda: (out / layout.DATASET_JSON).exists() or sim.poll() is not None
                   or recorder.poll() is not None, RECORDER_START_S)
         time.sleep(DISCOVERY_S)                  # let the recorder's capture subscriptions match
-        behaviour = _spawn([preset.behaviour, "--log", str(given), "--wait-recorder", *behaviour_args],
+        behaviour = _spawn([preset.behaviour, "--log", str(given), "--wait-recorder", "--lockstep",
+                            *behaviour_args],
                            env, logs / "behaviour.log")
         while behaviour.poll() is None:
             rows = _rows(captures)
