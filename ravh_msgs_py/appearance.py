@@ -24,6 +24,7 @@ SWITCH = ("on", "off", "random")
 DOOR = ("open", "closed", "random")
 LIGHT_GROUPS = ("all", "ceiling", "lamps")
 SURFACES = ("walls", "floor")
+SEED_MAX = 2**32 - 1       # the one seed range: settings files, command-line flags and requests
 
 
 def request(**changes: Any) -> str:
@@ -59,8 +60,8 @@ def parse(text: str | bytes | dict) -> dict[str, Any]:
             raise QueryError(BAD_REQUEST, f"models.{obj}: expected default, random, an index >= 0 or "
                                           f"{{inherit: OBJECT_ID}}, got {value!r}")
     for key in ("seed", "randomise"):
-        if key in data and not _is_int(data[key]):
-            raise QueryError(BAD_REQUEST, f"{key}: expected an integer")
+        if key in data and not (_is_int(data[key]) and 0 <= data[key] <= SEED_MAX):
+            raise QueryError(BAD_REQUEST, f"{key}: expected an integer in 0..{SEED_MAX}")
     return data
 
 

@@ -9,7 +9,6 @@ This module is plain Python with no dependency on the simulator, so clients can 
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -19,6 +18,12 @@ BAD_REQUEST = "bad_request"
 UNKNOWN_QUERY = "unknown_query"
 UNKNOWN_ID = "unknown_id"
 INTERNAL = "internal"
+
+# Requests are small; anything longer is refused before decoding, and no reply quotes more than a few
+# hundred characters of what it was sent (a 10 MB request must not come back or stay in memory).
+MAX_REQUEST_CHARS = 65_536
+MAX_MESSAGE_CHARS = 300
+MAX_COORDINATE = 1e6     # m: numbers in queries are positions; beyond this they are slips, not places
 
 
 @dataclass(frozen=True)
@@ -72,10 +77,14 @@ def ok_reply(result: Any) -> dict[str, Any]:
 
 
 def error_reply(code: str, message: str, valid: list | None = None) -> dict[str, Any]:
-    err: dict[str, Any] = {"code": code, "message": message}
+    err: dict[str, Any] = {"code": code, "message": shorten(message, MAX_MESSAGE_CHARS)}
     if valid:
         err["valid"] = list(valid)
     return {"ok": False, "error": err}
+
+
+def shorten(text: str, limit: int) -> str:
+    return text if len(text) <= limit else text[:limit - 20] + f"... ({len(text)} chars)"
 
 
 def request(query: str, **args: Any) -> str:
@@ -87,10 +96,14 @@ def decode(text: str | bytes | dict) -> Any:
     """A request as decoded JSON (a dict passes through); bad JSON raises :class:`QueryError`."""
     if isinstance(text, dict):
         return text
+    if isinstance(text, (str, bytes)) and len(text) > MAX_REQUEST_CHARS:
+        raise QueryError(BAD_REQUEST, f"request of {len(text)} characters is over the limit of {MAX_REQUEST_CHARS}")
     try:
         return json.loads(text)
     except (ValueError, TypeError) as e:
         raise QueryError(BAD_JSON, f"request is not valid JSON: {e}") from None
+    except RecursionError:
+        raise QueryError(BAD_JSON, "request is nested too deeply") from None
 
 
 def parse_request(text: str | bytes | dict) -> tuple[str, dict[str, Any]]:
@@ -99,7 +112,7 @@ def parse_request(text: str | bytes | dict) -> tuple[str, dict[str, Any]]:
     if not isinstance(data, dict):
         raise QueryError(BAD_REQUEST, 'request must be a JSON object like {"query": "rooms"}')
     name = data.get("query")
-    if name not in QUERIES:
+    if not isinstance(name, str) or name not in QUERIES:
         raise QueryError(UNKNOWN_QUERY, f"unknown query {name!r}", sorted(QUERIES))
     spec = QUERIES[name]
     args = {k: v for k, v in data.items() if k != "query"}
@@ -116,8 +129,10 @@ def parse_request(text: str | bytes | dict) -> tuple[str, dict[str, Any]]:
         if isinstance(value, bool) and arg.kind is not bool or not isinstance(value, arg.kind):
             raise QueryError(BAD_REQUEST, f"argument {arg.name!r} of {name!r} has the wrong type "
                                           f"({type(value).__name__})")
-        if isinstance(value, float) and not math.isfinite(value):
-            raise QueryError(BAD_REQUEST, f"argument {arg.name!r} must be finite")
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and not (
+                -MAX_COORDINATE <= value <= MAX_COORDINATE):                  # False for NaN too
+            raise QueryError(BAD_REQUEST, f"argument {arg.name!r} must be finite and within "
+                                          f"+-{MAX_COORDINATE:g}")
     return name, args
 
 

@@ -16,6 +16,7 @@ import time
 from typing import Any
 
 from ravh_msgs_py import names as n
+from ravh_sim.nodes.common import ros_domain_id
 from ravh_sim.paths import FASTDDS_PROFILE
 
 CLK_TCK = os.sysconf("SC_CLK_TCK")
@@ -43,7 +44,7 @@ def _peak_rss_mb(pid: int) -> float:
 def _session(house: int, seconds: float, profile: bool) -> dict[str, Any]:
     """One sim + probe run; returns the probe's report plus the sim's CPU and memory."""
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
-               ROS_DOMAIN_ID=str(100 + os.getpid() % 100))
+               ROS_DOMAIN_ID=ros_domain_id(100 + os.getpid())[0])
     if profile:
         env["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(FASTDDS_PROFILE)
     else:

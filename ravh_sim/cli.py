@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from collections import Counter
 from pathlib import Path
@@ -39,6 +40,12 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except KeyboardInterrupt:
         return 130
+    except BrokenPipeError:                        # `ravh houses --json | head`: the reader left
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())   # no second error at exit
+        return 141                                 # 128 + SIGPIPE, as a shell reports it
+    except OSError as e:                           # unwritable output, full disk: files are written atomically
+        print(f"ravh: error: {e.filename or ''}: {e.strerror or e}", file=sys.stderr)
+        return 2
 
 
 # ---------------------------------------------------------------------------- helpers
@@ -155,6 +162,7 @@ def cmd_render(args: argparse.Namespace) -> int:
     from ravh_sim.world.appearance import Appearance
     from ravh_sim.world.scene import World
     house, resolved = _resolved(args)
+    house.room_at_or_raise(*args.pose[:2])           # an all-sky picture from outside helps nobody
     with World(house, resolved, renderer=args.renderer) as world:
         appearance = Appearance(world)
         if args.sun is not None:

@@ -16,12 +16,14 @@ from typing import Any
 
 from ravh_msgs_py import appearance as appearance_lang
 from ravh_msgs_py import names
-from ravh_msgs_py.query import BAD_REQUEST, INTERNAL, QueryError, error_reply, ok_reply
+from ravh_msgs_py.query import BAD_REQUEST, INTERNAL, MAX_COORDINATE, QueryError, error_reply, ok_reply
 from ravh_sim.errors import UserError
 from ravh_sim.nav.navigation import Navigation
+from ravh_sim.nav.planner import Path as PlannedPath
 from ravh_sim.robot.profile import RobotProfile, load_profile
 from ravh_sim.robot.robot import Robot, compose, relative
 from ravh_sim.robot.simulation import Simulation
+from ravh_sim.schema import shown
 from ravh_sim.sensors.camera import CameraOptions, Capture, SmartCamera
 from ravh_sim.sensors.laser import Laser, Scan
 from ravh_sim.sensors.mount import LINK_TO_OPTICAL, mount_position, mount_rotation, quaternion_from_matrix
@@ -157,6 +159,14 @@ class SimRuntime:
                             f"(limits {agent.profile.max_linear_speed} m/s, "
                             f"{agent.profile.max_angular_speed:.3g} rad/s)")
         agent.robot.set_command(v, w)
+
+    def plan(self, start: tuple[float, float], goal: tuple[float, float]) -> PlannedPath:
+        """A GetPlan request: numbers are checked here, before they reach numpy and the planner."""
+        for name, (x, y) in (("start", start), ("goal", goal)):
+            if not all(-MAX_COORDINATE <= v <= MAX_COORDINATE for v in (x, y)):   # False for NaN too
+                raise UserError(f"rejected {name} ({shown(x)}, {shown(y)}): coordinates must be finite and "
+                                f"within +-{MAX_COORDINATE:g} m")
+        return self.navigation.plan(start, goal)
 
     def reset(self) -> None:
         """Agents back to their start poses, stopped; appearance back to the initial settings."""

@@ -33,3 +33,8 @@ def default_settings():
 def resolved(house, settings=None, seed=0):
     from ravh_sim.world.settings import load_settings, resolve
     return resolve(settings or load_settings(), house, seed)
+
+
+def pytest_report_header(config) -> str:
+    from rosgraph import DOMAIN_ID, DOMAIN_ID_SOURCE
+    return f"ROS_DOMAIN_ID {DOMAIN_ID} ({DOMAIN_ID_SOURCE})"

@@ -1,7 +1,8 @@
 """Helpers for integration tests: run real nodes in subprocesses and watch them with rclpy.
 
-Each test run gets its own ROS_DOMAIN_ID and ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST, so DDS traffic
-stays on this machine and parallel runs do not see each other. Nodes are stopped with SIGINT (SIGKILL
+Each test run uses the user's ROS_DOMAIN_ID when set, else one of its own (the report header says
+which), and ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST, so DDS traffic stays on this machine and parallel
+runs do not see each other. Nodes are stopped with SIGINT (SIGKILL
 leaves Fast DDS shared-memory files behind).
 """
 from __future__ import annotations
@@ -15,7 +16,9 @@ from typing import Any, Callable
 
 from conftest import ROOT, subprocess_env
 
-DOMAIN_ID = str(10 + os.getpid() % 200)
+from ravh_sim.nodes.common import ros_domain_id
+
+DOMAIN_ID, DOMAIN_ID_SOURCE = ros_domain_id(10 + os.getpid())
 
 
 def ros_env(**extra: str) -> dict[str, str]:

@@ -73,3 +73,20 @@ def test_bad_config_field_is_named(capsys, tmp_path):
     cfg.write_text("doors:\n  all: ajar\n")
     code, _, err = run_cli(capsys, "footprint", "15", "--config", str(cfg), "-o", str(tmp_path / "f.json"))
     assert code == 2 and f"{cfg}: doors.all:" in err and "ajar" in err
+
+
+@pytest.mark.parametrize("argv", [["houses", "--json"], ["query", "15", '{"query": "help"}']])
+def test_a_reader_that_leaves_early_is_no_error(argv):
+    """`ravh houses --json | head`: the pipe closes before ravh writes; no traceback."""
+    proc = subprocess.Popen([sys.executable, "-m", "ravh_sim.cli", *argv], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, env=subprocess_env())
+    proc.stdout.close()
+    _, err = proc.communicate(timeout=120)
+    assert b"Traceback" not in err and b"BrokenPipe" not in err, err.decode()[-2000:]
+    assert proc.returncode == 141
+
+
+def test_render_outside_every_room_names_the_nearest_room(capsys, tmp_path):
+    code, _, err = run_cli(capsys, "render", "15", "--pose", "1000", "1000", "0", "-o", str(tmp_path / "r"))
+    assert code == 2 and "outside every room of house 15; nearest room: " in err
+    assert not (tmp_path / "r").exists()

@@ -70,7 +70,7 @@ def _house_dict(n: int = 20) -> dict:
 @pytest.mark.parametrize("mutate, field", [
     (lambda d: d["rooms"][1].pop("floor"), "rooms[1].floor"),
     (lambda d: d["objects"][3].__setitem__("yaw", "north"), "objects[3].yaw"),
-    (lambda d: d["objects"][2]["models"][0].__setitem__("size", [1, -2, 3]), "objects[2].models[0].size"),
+    (lambda d: d["objects"][2]["models"][0].__setitem__("size", [1, -2, 3]), "objects[2].models[0].size[1]"),
     (lambda d: d["walls"][0].__setitem__("room", "Attic_9"), "walls[0].room"),
     (lambda d: d["doors"][0].__setitem__("rooms", []), "doors[0].rooms"),
     (lambda d: d["lights"][0].__setitem__("kind", "laser"), "lights[0].kind"),

@@ -42,8 +42,12 @@ def test_two_agents_have_their_own_topics_and_move_independently(tmp_path):
         assert (p2.x, p2.y) == pytest.approx((-1.5, 1.5), abs=0.15)
         turn = Twist()
         turn.angular.z = 0.4
-        end = time.monotonic() + 2.0
-        while time.monotonic() < end:
+        def turned() -> bool:
+            q = got["pose2"][-1].pose.orientation
+            return abs(2 * math.atan2(q.z, q.w)) > 0.3
+
+        end = time.monotonic() + 60                    # however long 0.3 rad takes on a loaded machine
+        while not turned() and time.monotonic() < end:
             cmd2.publish(turn)
             spin_until(node, lambda: False, 0.1)
         q2 = got["pose2"][-1].pose.orientation

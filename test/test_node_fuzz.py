@@ -1,7 +1,8 @@
 """Property-based fuzzing of a running sim node: thousands of random requests, the node never dies.
 
-Random JSON (well-formed and not) goes to the query and appearance services and random floats to
-cmd_vel; every reply must be a well-formed envelope, and afterwards the node still runs and answers.
+Random JSON (well-formed and not, extremes included: +-1e308, NaN, inf, 5e-324, 10 MB strings) goes to
+the query and appearance services, random points to GetPlan and random floats to cmd_vel; every reply
+must be a well-formed envelope that never says ``internal``, and afterwards every service still answers.
 """
 from __future__ import annotations
 
@@ -16,6 +17,8 @@ rclpy = pytest.importorskip("rclpy")
 
 from diagnostic_msgs.srv import AddDiagnostics  # noqa: E402
 from geometry_msgs.msg import Twist  # noqa: E402
+from nav_msgs.srv import GetMap, GetPlan  # noqa: E402
+from std_srvs.srv import Trigger  # noqa: E402
 
 from ravh_msgs_py import names as n  # noqa: E402
 from ravh_msgs_py.query import QUERIES  # noqa: E402
@@ -24,8 +27,11 @@ WORDS = ["Door_0", "Door_1", "Bed_0", "Chair_0", "Light_0", "Bedroom_1", "Bathro
          "lamps", "random", "on", "off", "open", "closed", "walls", "floor", "brick", "#ff0000", "night"]
 KEYS = ["query", "id", "room", "tag", "type", "x", "y", "open_only", "sun_angle", "lights", "doors",
         "paint", "models", "seed", "randomise", *QUERIES]
+EXTREMES = [1e308, -1e308, float("nan"), float("inf"), -float("inf"), 5e-324, -5e-324, 10**400, -(2**64)]
+HUGE = "x" * 10_000_000
+floats = st.floats(allow_nan=True, allow_infinity=True) | st.sampled_from(EXTREMES[:7])
 scalars = (st.none() | st.booleans() | st.integers(-10**12, 10**12) | st.floats(allow_nan=True)
-           | st.sampled_from(WORDS) | st.text(max_size=12))
+           | st.sampled_from(WORDS) | st.text(max_size=12) | st.sampled_from(EXTREMES))
 values = st.recursive(scalars, lambda kids: st.lists(kids, max_size=3)
                       | st.dictionaries(st.sampled_from(KEYS + WORDS), kids, max_size=3), max_leaves=8)
 requests = st.dictionaries(st.sampled_from(KEYS), values, max_size=4)
@@ -53,6 +59,10 @@ def node():
     start_rclpy()
     probe = rclpy.create_node("fuzzer")
     clients = {name: probe.create_client(AddDiagnostics, name) for name in (n.QUERY_SERVICE, n.APPEARANCE_SERVICE)}
+    clients.update({n.GET_PLAN_SERVICE: probe.create_client(GetPlan, n.GET_PLAN_SERVICE),
+                    n.GET_MAP_SERVICE: probe.create_client(GetMap, n.GET_MAP_SERVICE),
+                    n.RESET_SERVICE: probe.create_client(Trigger, n.RESET_SERVICE),
+                    n.CAPTURE_SERVICE: probe.create_client(Trigger, n.CAPTURE_SERVICE)})
     assert all(c.wait_for_service(timeout_sec=90) for c in clients.values()), proc.log()[-2000:]
     yield proc, probe, clients, probe.create_publisher(Twist, n.CMD_VEL, 10)
     probe.destroy_node()
@@ -60,14 +70,21 @@ def node():
     assert "Traceback" not in proc.log()
 
 
+def answer(probe, client, request):
+    future = client.call_async(request)
+    assert spin_until(probe, future.done, 60), "no reply"
+    return future.result()
+
+
 def call(probe, client, text: str) -> dict:
-    future = client.call_async(AddDiagnostics.Request(load_namespace=text))
-    assert spin_until(probe, future.done, 20), "no reply"
-    reply = json.loads(future.result().message)
+    result = answer(probe, client, AddDiagnostics.Request(load_namespace=text))
+    reply = json.loads(result.message)
     assert set(reply) == ({"ok", "result"} if reply["ok"] else {"ok", "error"})
-    assert future.result().success == reply["ok"]
+    assert result.success == reply["ok"]
     if not reply["ok"]:
         assert reply["error"]["code"] and reply["error"]["message"]
+        assert reply["error"]["code"] != "internal", reply
+        assert len(result.message) < 20_000          # a huge request is never echoed back
     return reply
 
 
@@ -98,9 +115,34 @@ def test_random_velocities_never_hurt(node, v, w):
     rclpy.spin_once(probe, timeout_sec=0)
 
 
+@settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
+@given(points=st.lists(floats, min_size=4, max_size=4))
+def test_random_plans_never_hurt(node, points):
+    _, probe, clients, _ = node
+    request = GetPlan.Request()
+    p = request.start.pose.position, request.goal.pose.position
+    p[0].x, p[0].y, p[1].x, p[1].y = points
+    answer(probe, clients[n.GET_PLAN_SERVICE], request)
+
+
+@pytest.mark.parametrize("service", [n.QUERY_SERVICE, n.APPEARANCE_SERVICE])
+@pytest.mark.parametrize("text", [HUGE, json.dumps({"query": HUGE}), json.dumps({"query": "room", "id": HUGE}),
+                                  json.dumps({"sun_angle": 1e308, "seed": 10**400}), "[" * 100_000])
+def test_huge_and_deep_requests_get_short_errors(node, service, text):
+    _, probe, clients, _ = node
+    assert call(probe, clients[service], text)["ok"] is False
+
+
 def test_node_survives_and_still_answers(node):
     proc, probe, clients, _ = node
     assert proc.alive()
     reply = call(probe, clients[n.QUERY_SERVICE], '{"query": "counts"}')
     assert reply["ok"] and reply["result"]["rooms"] == 3
     assert call(probe, clients[n.QUERY_SERVICE], '{"query": "room_at", "x": 0, "y": 0}')["ok"] is True
+    assert answer(probe, clients[n.RESET_SERVICE], Trigger.Request()).success      # undo the fuzzed appearance
+    request = GetPlan.Request()
+    request.start.pose.position.x, request.start.pose.position.y = -3.0, 1.2
+    request.goal.pose.position.x, request.goal.pose.position.y = -5.0, 0.0
+    assert len(answer(probe, clients[n.GET_PLAN_SERVICE], request).plan.poses) > 2
+    assert answer(probe, clients[n.GET_MAP_SERVICE], GetMap.Request()).map.info.width > 0
+    assert answer(probe, clients[n.CAPTURE_SERVICE], Trigger.Request()).success

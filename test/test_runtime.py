@@ -1,6 +1,7 @@
 """The ROS-free runtime and the message conversions the node uses."""
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -167,3 +168,54 @@ def test_profile_camera_effects_are_validated(tmp_path):
     bad.write_text(yaml.safe_dump(data))
     with pytest.raises(FileFieldError, match="camera.effects.sparkle"):
         load_profile(bad)
+
+
+# ------------------------------------------------------------------ requests with extreme numbers
+# The core checks every number a request carries before numpy or the planner see it (issue 13, item 4):
+# a bad request is a structured bad_request (never internal) that does not quote a huge input back.
+
+EXTREMES = [1e308, -1e308, math.nan, math.inf, -math.inf, 5e-324, -0.0, 10**400, -(10**30), 2**63]
+HUGE = "x" * 10_000_000
+
+
+@pytest.mark.parametrize("x", EXTREMES)
+def test_plans_to_extreme_points_are_refused(runtime, x):
+    for start, goal in (((x, 0.0), (0.0, 0.0)), ((-3.0, 1.6), (x, x))):
+        try:
+            runtime.plan(start, goal)
+        except UserError as e:
+            assert "\n" not in str(e)
+
+
+@pytest.mark.parametrize("x", EXTREMES)
+def test_queries_with_extreme_numbers_are_bad_requests(runtime, x):
+    import json
+    reply = runtime.query(json.dumps({"query": "room_at", "x": x, "y": 0.0}))
+    assert reply["ok"] == (abs(x) < 1e6), reply
+    if not reply["ok"]:
+        assert reply["error"]["code"] == "bad_request"
+
+
+@pytest.mark.parametrize("request_", [
+    '{"query": {"a": 1}}', '{"query": [1]}', '{"query": "room", "id": 7}', '{"query": "room", "id": [1]}',
+    '{"query": "rooms", "type": {"x": 1}}', '{"query": "room_at", "x": "1", "y": 2}', "[1, 2]", "7",
+])
+def test_wrong_typed_queries_are_bad_requests(runtime, request_):
+    assert runtime.query(request_)["error"]["code"] in ("bad_request", "unknown_query")
+
+
+@pytest.mark.parametrize("request_", [
+    HUGE, '{"query": "' + HUGE + '"}', '{"query": "room", "id": "' + HUGE + '"}',
+    '{"sun_angle": "' + HUGE + '"}', '{"doors": {"' + HUGE + '": "open"}}', "[" * 60_000,
+])
+def test_huge_requests_are_refused_without_echo(runtime, request_):
+    for reply in (runtime.query(request_), runtime.change_appearance(request_)):
+        assert not reply["ok"] and reply["error"]["code"] != "internal"
+        assert len(json.dumps(reply)) < 2_000
+
+
+@pytest.mark.parametrize("key, value", [("seed", -5), ("seed", 10**30), ("randomise", 2**40), ("seed", 1.5),
+                                        ("sun_angle", 1e308), ("sun_angle", math.nan), ("models", {"Bed_0": 10**400})])
+def test_appearance_numbers_are_checked(runtime, key, value):
+    reply = runtime.change_appearance(json.dumps({key: value}))
+    assert reply["error"]["code"] in ("bad_request", "unknown_id"), reply

@@ -112,21 +112,20 @@ def test_rates_in_sim_time(sim):
     _, probe = sim
     for topic in RATES:
         probe.got[topic].clear()
-    probe.spin(3.0)
+    assert spin_until(probe.node, lambda: all(len(probe.got[t]) >= 10 for t in RATES), 60)
     for topic, rate in RATES.items():
         stamps = [stamp_s(m) for m in probe.got[topic]]
-        assert len(stamps) >= 5, topic
         measured = (len(stamps) - 1) / (stamps[-1] - stamps[0])
         assert measured == pytest.approx(rate, rel=0.1), topic
 
 
 def test_one_capture_shares_one_stamp(sim):
     _, probe = sim
-    probe.spin(1.0)
-    stamps = {t: {stamp_s(m) for m in probe.got[t]} for t in
-              (n.COLOR_IMAGE, n.DEPTH_IMAGE, n.INSTANCE_IMAGE, n.COLOR_INFO, n.DEPTH_INFO, n.COLOR_COMPRESSED)}
-    common = set.intersection(*stamps.values())
-    assert len(common) >= 3
+    topics = (n.COLOR_IMAGE, n.DEPTH_IMAGE, n.INSTANCE_IMAGE, n.COLOR_INFO, n.DEPTH_INFO, n.COLOR_COMPRESSED)
+
+    def common() -> set:
+        return set.intersection(*({stamp_s(m) for m in probe.got[t]} for t in topics))
+    assert spin_until(probe.node, lambda: len(common()) >= 3, 60)
 
 
 def test_camera_info_follows_the_papers_formula(sim):
@@ -148,28 +147,36 @@ def test_depth_is_metres_and_scan_follows_rep117(sim):
 
 
 def test_clock_advances(sim):
+    """Sim time moves forward and never back; how fast depends on the machine's load, so no rate."""
     _, probe = sim
     before = stamp_s(probe.got[n.CLOCK][-1])
-    probe.spin(1.0)
-    assert stamp_s(probe.got[n.CLOCK][-1]) > before + 0.5
+    seen = len(probe.got[n.CLOCK])
+    assert spin_until(probe.node, lambda: stamp_s(probe.got[n.CLOCK][-1]) > before + 0.5, 60)
+    stamps = [stamp_s(m) for m in probe.got[n.CLOCK][seen - 1:]]
+    assert all(b > a for a, b in zip(stamps, stamps[1:]))
+
+
+def _yaw(q) -> float:
+    return 2 * math.atan2(q.z, q.w)
 
 
 def test_cmd_vel_moves_the_robot(sim):
     _, probe = sim
-    pose0 = probe.got[n.GROUND_TRUTH_POSE][-1].pose.position
-    odom0 = probe.got[n.ODOM][-1].pose.pose.position
+    gt0 = probe.got[n.GROUND_TRUTH_POSE][-1].pose.orientation
+    odom0 = probe.got[n.ODOM][-1].pose.pose.orientation
     scan0 = np.array(probe.got[n.SCAN][-1].ranges)
     turn = Twist()
     turn.angular.z = 0.4
-    end = time.monotonic() + 2.5
-    while time.monotonic() < end:
+
+    def turned(q0, q) -> float:
+        return abs(math.remainder(_yaw(q) - _yaw(q0), 2 * math.pi))
+
+    end = time.monotonic() + 60                   # however long half a radian takes on this machine
+    while turned(gt0, probe.got[n.GROUND_TRUTH_POSE][-1].pose.orientation) < 0.5 and time.monotonic() < end:
         probe.cmd.publish(turn)
         probe.spin(0.1)
-    gt = probe.got[n.GROUND_TRUTH_POSE][-1].pose
-    yaw_change = abs(math.atan2(gt.orientation.z, gt.orientation.w) * 2)
-    assert yaw_change > 0.3 or math.dist((gt.position.x, gt.position.y), (pose0.x, pose0.y)) > 0.1
-    odom = probe.got[n.ODOM][-1].pose.pose
-    assert abs(odom.orientation.z) > 0.1 or math.dist((odom.position.x,), (odom0.x,)) > 0.05
+    assert turned(gt0, probe.got[n.GROUND_TRUTH_POSE][-1].pose.orientation) >= 0.5
+    assert turned(odom0, probe.got[n.ODOM][-1].pose.pose.orientation) > 0.3      # odometry saw the turn
     scan1 = np.array(probe.got[n.SCAN][-1].ranges)
     both = np.isfinite(scan0) & np.isfinite(scan1)
     assert np.abs(scan1[both] - scan0[both]).max() > 0.1

@@ -13,6 +13,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from ravh_sim.files import TMP_PREFIX, atomic_write  # noqa: F401  (the dataset's writes are these)
+
 FORMAT = "ravh_sim/dataset@1"
 
 DATASET_JSON = "dataset.json"          # format, house, agents, created, raid metadata
@@ -23,7 +25,6 @@ CAPTURES_JSONL = "captures.jsonl"      # one line per complete capture
 MAP_DIR = "map"                        # map.pgm + map.yaml (map_server format)
 MAP_NAME = "map"
 BAG_DIR = "bag"                        # rosbag2, MCAP storage
-TMP_PREFIX = "."                       # temporary files are hidden: ".<name>.<pid>.tmp"
 
 #: Per-capture files: kind -> (folder, extension).
 CAPTURE_FILES: dict[str, tuple[str, str]] = {
@@ -37,20 +38,6 @@ CAPTURE_FILES: dict[str, tuple[str, str]] = {
 def capture_files(index: int) -> dict[str, str]:
     """Relative paths of capture ``index``'s files, by kind."""
     return {kind: f"{folder}/{index:06d}{ext}" for kind, (folder, ext) in CAPTURE_FILES.items()}
-
-
-def atomic_write(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` all at once: temp file in the same folder, fsync, rename.
-
-    The fsync before the rename keeps the name from ever pointing at unwritten blocks after a
-    power loss; os.replace is atomic on POSIX, so readers see the old file or the new one.
-    """
-    tmp = path.with_name(f"{TMP_PREFIX}{path.name}.{os.getpid()}.tmp")
-    with open(tmp, "wb") as f:
-        f.write(data)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
 
 
 def encode_png(image: np.ndarray) -> bytes:

@@ -2,9 +2,17 @@
 
 A raid is one house under one appearance preset, explored by one behaviour while the recorder writes
 the dataset. The presets are the paper's five; each becomes a settings file (saved in the output folder,
-so the raid can be rerun) passed to the sim node. Every raid gets its own ROS_DOMAIN_ID so raids on one
-machine never hear each other. Processes are stopped with SIGINT in the order that loses nothing:
-behaviour done -> recorder (flushes what it has) -> sim.
+so the raid can be rerun) passed to the sim node. A raid runs on the user's ROS_DOMAIN_ID when one is
+set, else on one of its own so raids on one machine never hear each other (it says which). Processes
+are stopped with SIGINT in the order that loses nothing: behaviour done -> recorder (once it has every
+capture the behaviour was given, or has given up) -> sim.
+
+Raids are reproducible: sim and behaviour run in lockstep (sim time advances only as the behaviour
+grants it), so the same seed gives the same captures, poses and images. Nothing is lost silently: the
+behaviour runs with ``--wait-recorder`` (a capture counts once the
+recorder confirms it), and the status is ``done`` only when the behaviour finished, every process
+exited cleanly and the dataset holds every capture the behaviour logged. The output folder must be new
+or empty; raid.json is written atomically, also after Ctrl-C, and says what happened.
 """
 from __future__ import annotations
 
@@ -14,17 +22,22 @@ import signal
 import subprocess
 import sys
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
 
+from ravh_sim.dataset import layout
 from ravh_sim.errors import UserError
+from ravh_sim.nodes.common import ros_domain_id
+from ravh_sim.world.settings import check_seed
 
 FAST_RTF = 4.0                   # --fast: sim seconds per wall second asked of the sim node
 POLL_S = 0.5
 RECORDER_START_S = 120.0         # the recorder is ready once the sim's footprint reached it
 DISCOVERY_S = 2.0
+HANDOVER_GRACE_S = 30.0          # wall seconds the recorder gets to store the behaviour's last captures
 
 
 @dataclass(frozen=True)
@@ -56,36 +69,43 @@ def preset_settings(preset: RaidPreset, seed: int) -> dict:
 
 def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | None = None,
              max_captures: int = 0, max_nodes: int = 0, timeout: float = 3600.0, quiet: bool = False) -> dict:
-    """Run one raid into ``out``; returns its summary (also written to ``out/raid.json``)."""
+    """Run one raid into the new folder ``out``; returns its summary (also written to ``out/raid.json``)."""
     if not 0 <= raid < len(PRESETS):
         raise UserError(f"unknown raid {raid}; valid: {', '.join(map(str, range(len(PRESETS))))}")
     preset = PRESETS[raid]
-    seed = house * 10 + raid if seed is None else seed
-    out.mkdir(parents=True, exist_ok=True)
-    settings_path = out / "raid_settings.yaml"
-    settings_path.write_text(yaml.safe_dump(preset_settings(preset, seed), sort_keys=False))
-    env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE=os.environ.get("ROS_AUTOMATIC_DISCOVERY_RANGE",
-                                                                          "LOCALHOST"),
-               ROS_DOMAIN_ID=str(1 + (os.getpid() * 7 + house * 5 + raid) % 200))
+    seed = check_seed(house * 10 + raid if seed is None else seed)
     logs = out / "logs"
-    logs.mkdir(exist_ok=True)
+    settings_path = out / "raid_settings.yaml"
+    with _writing(out):
+        if out.exists() and (not out.is_dir() or any(out.iterdir())):
+            raise UserError(f"{out} exists and is not empty; raid into a new folder")
+        logs.mkdir(parents=True)
+        layout.atomic_write(settings_path, yaml.safe_dump(preset_settings(preset, seed), sort_keys=False).encode())
+    domain, how = ros_domain_id(os.getpid() * 7 + house * 5 + raid)
+    if not quiet:
+        print(f"ravh raid: ROS_DOMAIN_ID {domain} ({how})", file=sys.stderr)
+    env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE=os.environ.get("ROS_AUTOMATIC_DISCOVERY_RANGE",
+                                                                          "LOCALHOST"), ROS_DOMAIN_ID=domain)
     rtf = FAST_RTF if fast else 1.0
     behaviour_args = (["--order", "once", "--capture-period", "0.5"] if preset.behaviour == "wanderer"
                       else ["--captures", "10", "--max-nodes", str(max_nodes)])
     start = time.monotonic()
-    sim = _spawn(["sim", "--house", str(house), "--config", str(settings_path), "--rtf", str(rtf),
-                  "--camera-rate", "0"], env, logs / "sim.log")
-    raid_meta = {"house": house, "raid": raid, "preset": preset.__dict__, "seed": seed, "fast": fast}
-    recorder = _spawn(["recorder", "--out", str(out), "--raid", json.dumps(raid_meta)], env,
-                      logs / "recorder.log")
-    _wait_for(lambda: (out / "dataset.json").exists() or sim.poll() is not None
-              or recorder.poll() is not None, RECORDER_START_S)
-    time.sleep(DISCOVERY_S)                      # let the recorder's capture subscriptions match
-    behaviour = _spawn([preset.behaviour, "--log", str(logs / "behaviour_captures.jsonl"), *behaviour_args],
-                       env, logs / "behaviour.log")
-    captures = out / "captures.jsonl"
+    raid_meta = {"house": house, "raid": raid, "preset": preset.__dict__, "seed": seed, "fast": fast,
+                 "ros_domain_id": domain}
+    captures, given = out / layout.CAPTURES_JSONL, logs / "behaviour_captures.jsonl"
     status = "done"
+    sim = recorder = behaviour = None
     try:
+        sim = _spawn(["sim", "--house", str(house), "--config", str(settings_path), "--rtf", str(rtf),
+                      "--camera-rate", "0", "--lockstep"], env, logs / "sim.log")
+        recorder = _spawn(["recorder", "--out", str(out), "--raid", json.dumps(raid_meta)], env,
+                          logs / "recorder.log")
+        _wait_for(lambda: (out / layout.DATASET_JSON).exists() or sim.poll() is not None
+                  or recorder.poll() is not None, RECORDER_START_S)
+        time.sleep(DISCOVERY_S)                  # let the recorder's capture subscriptions match
+        behaviour = _spawn([preset.behaviour, "--log", str(given), "--wait-recorder", "--lockstep",
+                            *behaviour_args],
+                           env, logs / "behaviour.log")
         while behaviour.poll() is None:
             rows = _rows(captures)
             if not quiet:
@@ -102,20 +122,47 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
                 status = f"timed out after {timeout:.0f} s"
                 break
             time.sleep(POLL_S)
+    except KeyboardInterrupt:
+        status = "interrupted (Ctrl-C)"
     finally:
-        for proc in (behaviour, recorder, sim):
-            _stop(proc)
-    wall = time.monotonic() - start
-    rows = _rows(captures)
-    summary = {**raid_meta, "status": status if behaviour.returncode in (0, None) or status != "done"
-               else f"behaviour exited with {behaviour.returncode}",
-               "captures": len(rows), "rooms_visited": sorted({r["room"] for r in rows if r.get("room")}),
-               "wall_s": round(wall, 1),
+        _stop(behaviour)
+        if recorder is not None:
+            _wait_for(lambda: len(_rows(captures)) >= len(_rows(given)) or recorder.poll() is not None,
+                      HANDOVER_GRACE_S)
+        _stop(recorder)
+        _stop(sim)
+    rows, requested = _rows(captures), len(_rows(given))
+    status = _final_status(status, requested, len(rows), behaviour, recorder)
+    summary = {**raid_meta, "status": status, "captures": len(rows), "requested": requested,
+               "rooms_visited": sorted({r["room"] for r in rows if r.get("room")}),
+               "wall_s": round(time.monotonic() - start, 1),
                "sim_s": round(rows[-1]["stamp"] - rows[0]["stamp"], 1) if len(rows) > 1 else 0.0}
-    (out / "raid.json").write_text(json.dumps(summary, indent=1))
+    with _writing(out, f"; the raid ended: {status}"):
+        layout.atomic_write(out / "raid.json", (json.dumps(summary, indent=1) + "\n").encode())
     if not quiet:
         print(file=sys.stderr)
     return summary
+
+
+def _final_status(status: str, requested: int, recorded: int, behaviour: subprocess.Popen | None,
+                  recorder: subprocess.Popen | None) -> str:
+    """What the raid amounts to: losses first, then a process that failed, then how it ended."""
+    if recorded < requested:
+        return f"lost {requested - recorded} of {requested} captures (see logs/)"
+    if status == "done":
+        for name, proc in (("behaviour", behaviour), ("recorder", recorder)):
+            if proc is not None and proc.returncode not in (0, None):
+                return f"{name} exited with {proc.returncode} (see logs/{name}.log)"
+    return status
+
+
+@contextmanager
+def _writing(out: Path, context: str = ""):
+    """OSErrors while writing the raid folder become one line naming the file."""
+    try:
+        yield
+    except OSError as e:
+        raise UserError(f"{e.filename or out}: cannot write the raid: {e.strerror}{context}") from None
 
 
 def _wait_for(condition, timeout: float) -> None:
@@ -130,8 +177,8 @@ def _spawn(args: list[str], env: dict[str, str], log: Path) -> subprocess.Popen:
                                 stderr=subprocess.STDOUT)
 
 
-def _stop(proc: subprocess.Popen, timeout: float = 30.0) -> None:
-    if proc.poll() is None:
+def _stop(proc: subprocess.Popen | None, timeout: float = 30.0) -> None:
+    if proc is not None and proc.poll() is None:
         proc.send_signal(signal.SIGINT)
         try:
             proc.wait(timeout)

@@ -33,15 +33,18 @@ class DatasetWriter:
 
     def __init__(self, directory: str | Path) -> None:
         self.dir = Path(directory)
-        self.dir.mkdir(parents=True, exist_ok=True)
-        if (self.dir / layout.DATASET_JSON).exists():
-            raise UserError(f"{self.dir} already holds a dataset; record into a new folder")
         try:
-            self._rows = open(self.dir / layout.CAPTURES_JSONL, "x", encoding="utf-8")
-        except FileExistsError:
-            raise UserError(f"{self.dir} already holds {layout.CAPTURES_JSONL}; record into a new folder") from None
-        for folder, _ in layout.CAPTURE_FILES.values():
-            (self.dir / folder).mkdir(exist_ok=True)
+            self.dir.mkdir(parents=True, exist_ok=True)
+            if (self.dir / layout.DATASET_JSON).exists():
+                raise UserError(f"{self.dir} already holds a dataset; record into a new folder")
+            try:
+                self._rows = open(self.dir / layout.CAPTURES_JSONL, "x", encoding="utf-8")
+            except FileExistsError:
+                raise UserError(f"{self.dir} already holds {layout.CAPTURES_JSONL}; record into a new folder") from None
+            for folder, _ in layout.CAPTURE_FILES.values():
+                (self.dir / folder).mkdir(exist_ok=True)
+        except OSError as e:
+            raise UserError(f"{e.filename or self.dir}: cannot write the dataset: {e.strerror}") from None
         self.count = 0
         self._room_types: dict[str, str] = {}
         self._cameras: dict[str, dict[str, Any]] = {}

@@ -21,6 +21,7 @@ import numpy as np
 import yaml
 
 from ravh_sim.errors import FileFieldError
+from ravh_sim.files import atomic_write
 from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid
 
 FREE_PIXEL, OCCUPIED_PIXEL, UNKNOWN_PIXEL = 254, 0, 205
@@ -37,7 +38,7 @@ def write_map(grid: Grid, directory: str | Path, name: str = "map") -> tuple[Pat
     pixels[grid.data == OCCUPIED] = OCCUPIED_PIXEL
     rows, cols = grid.shape
     header = f"P5\n# ravh_sim map, {grid.resolution} m/cell\n{cols} {rows}\n255\n".encode()
-    pgm_path.write_bytes(header + pixels[::-1].tobytes())
+    atomic_write(pgm_path, header + pixels[::-1].tobytes())
     description = {
         "image": pgm_path.name,
         "mode": "trinary",
@@ -47,7 +48,7 @@ def write_map(grid: Grid, directory: str | Path, name: str = "map") -> tuple[Pat
         "occupied_thresh": OCCUPIED_THRESH,
         "free_thresh": FREE_THRESH,
     }
-    yaml_path.write_text(yaml.safe_dump(description, sort_keys=False, default_flow_style=None))
+    atomic_write(yaml_path, yaml.safe_dump(description, sort_keys=False, default_flow_style=None).encode())
     return pgm_path, yaml_path
 
 

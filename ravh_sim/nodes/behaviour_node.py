@@ -4,6 +4,15 @@ The node learns the house from the ground-truth service (rooms, floors, ceiling 
 follows the robot on ground_truth/pose, drives it with cmd_vel and asks for captures through the
 capture service. It runs on sim time, so it keeps pace with a sim that runs faster than real time.
 Every capture it gets back is logged with its pose and room (and written to ``--log`` as JSON lines).
+
+With ``--wait-recorder`` (what ``ravh raid`` uses) a capture counts only once a recorder says it stored
+it (``ravh/capture_recorded``): the behaviour holds the robot still until then, so at most one capture
+is ever in flight and none can be lost under load; one that never arrives ends the run with an error.
+With ``--lockstep`` (also ``ravh raid``'s, with a sim started with --lockstep) the behaviour drives sim
+time: each control step it acts on the pose at the instant the sim stopped, then grants the next
+step together with its command on ``ravh/step``; nothing depends on wall-clock timing, so the same
+seed gives the same run.
+The node also stops with an error when the sim goes away (no /clock for a few wall seconds).
 """
 from __future__ import annotations
 
@@ -16,11 +25,13 @@ from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
-from geometry_msgs.msg import PoseStamped, Twist
+from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import OccupancyGrid
+from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.task import Future
+from std_msgs.msg import String
 from std_srvs.srv import Trigger
 
 from ravh_msgs_py import names as n
@@ -31,25 +42,33 @@ from ravh_sim.nav.follower import PathFollower
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.planner import Path as PlannedPath
 from ravh_sim.nav.planner import plan_path
-from ravh_sim.nodes.common import COMMAND_QOS, LATCHED_QOS, STATE_QOS, quiet_after_shutdown
+from ravh_sim.nodes import convert
+from ravh_sim.nodes.common import (COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, STATE_QOS, SimWatchdog,
+                                   quiet_after_shutdown)
 from ravh_sim.robot.profile import load_profile
 
 FIRST_AGENT = "robot"            # the default settings' agent; other agents' topics are prefixed
 CONTROL_HZ = 20.0                # sim-time control rate (as nav2's controllers)
 STARTUP_TIMEOUT_S = 60.0
+RECORD_TIMEOUT_S = 60.0          # wall seconds a recorder may take to confirm a capture
 
 
 class RosRobot:
     """The robot as the behaviours see it (``pose``, ``set_command``), over ROS topics."""
 
-    def __init__(self, node: Node, agent: str, first: bool) -> None:
-        self._pub = node.create_publisher(Twist, n.agent_name(n.CMD_VEL, agent, first), COMMAND_QOS)
+    def __init__(self, node: Node, agent: str, first: bool, lockstep: bool = False) -> None:
+        self._pub = None if lockstep else node.create_publisher(Twist, n.agent_name(n.CMD_VEL, agent, first),
+                                                                COMMAND_QOS)
+        self.command = (0.0, 0.0)             # lockstep: sent with the next step instead of on cmd_vel
         self.pose_msg: PoseStamped | None = None
+        self.on_pose: Callable[[PoseStamped], None] | None = None
         node.create_subscription(PoseStamped, n.agent_name(n.GROUND_TRUTH_POSE, agent, first),
                                  self._on_pose, STATE_QOS)
 
     def _on_pose(self, msg: PoseStamped) -> None:
         self.pose_msg = msg
+        if self.on_pose:
+            self.on_pose(msg)
 
     @property
     def pose(self) -> tuple[float, float, float]:
@@ -57,9 +76,11 @@ class RosRobot:
         return (p.position.x, p.position.y, 2.0 * math.atan2(p.orientation.z, p.orientation.w))
 
     def set_command(self, v: float, w: float) -> None:
-        msg = Twist()
-        msg.linear.x, msg.angular.z = float(v), float(w)
-        self._pub.publish(msg)
+        self.command = (float(v), float(w))
+        if self._pub:
+            msg = Twist()
+            msg.linear.x, msg.angular.z = self.command
+            self._pub.publish(msg)
 
 
 class RosNavigation:
@@ -94,25 +115,40 @@ class BehaviourNode(Node):
     """Hosts one behaviour: ``make_behaviour(follower, layout, grid, start_xy)`` builds it once the sim is up."""
 
     def __init__(self, name: str, make_behaviour: Callable[[PathFollower, Layout, Grid, tuple], Any],
-                 agent: str = FIRST_AGENT, profile: str = "giraff", log_path: Path | None = None) -> None:
+                 agent: str = FIRST_AGENT, profile: str = "giraff", log_path: Path | None = None,
+                 wait_recorder: bool = False, lockstep: bool = False) -> None:
         super().__init__(name, parameter_overrides=[Parameter("use_sim_time", value=True)])
         first = agent == FIRST_AGENT
-        self.robot = RosRobot(self, agent, first)
+        self.robot = RosRobot(self, agent, first, lockstep)
         self.navigation = RosNavigation(self)
         self.client = RavhClient(self)
         self.capture_client = self.create_client(Trigger, n.agent_name(n.CAPTURE_SERVICE, agent, first))
-        self.captures: list[dict[str, Any]] = []
+        self.capture_count = 0
         self.finished = Future()                 # done when the behaviour ends (run_node returns then)
         self._pending: set[Future] = set()
+        self.wait_recorder, self.lockstep = wait_recorder, lockstep
+        self._unrecorded: dict[float, tuple[dict[str, Any], float]] = {}   # stamp -> (event, wall deadline)
+        if wait_recorder:
+            self.create_subscription(String, n.agent_name(n.CAPTURE_RECORDED, agent, first), self._on_recorded,
+                                     HANDOVER_QOS)
         self._log_file = open(log_path, "a") if log_path else None
+        SimWatchdog(self)
+        self.create_timer(1.0, self._check_recorder, clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._wait_for_sim()
         layout = layout_from_ground_truth(self.client)
         follower = PathFollower(self.robot, self.navigation, load_profile(profile))
         self.behaviour = make_behaviour(follower, layout, self.navigation.grid, self.robot.pose[:2])
         self._last_t: float | None = None
         self._rooms_seen: set[str] = set()
-        self.timer = self.create_timer(1.0 / CONTROL_HZ, self._tick)
-        self.get_logger().info(f"{name}: started at {tuple(round(v, 2) for v in self.robot.pose)}")
+        self._granted: float | None = 0.0            # lockstep: sim time granted and not reached yet
+        self._reached: float | None = None           # lockstep: sim time reached, next step not granted
+        if lockstep:
+            self._step_pub = self.create_publisher(TwistStamped, n.agent_name(n.STEP, agent, first), HANDOVER_QOS)
+            self.robot.on_pose = self._on_pose_lockstep
+        else:
+            self.create_timer(1.0 / CONTROL_HZ, self._tick)
+        self.get_logger().info(f"{name}: started at {tuple(round(v, 2) for v in self.robot.pose)}"
+                               + (" (lockstep)" if lockstep else ""))
 
     def _wait_for_sim(self) -> None:
         import rclpy
@@ -127,43 +163,96 @@ class BehaviourNode(Node):
 
     @quiet_after_shutdown
     def _tick(self) -> None:
+        """Sim-time timer (not lockstep): one control step, unless holding for the recorder."""
         now = self.get_clock().now().nanoseconds * 1e-9
+        if self._holding():
+            self.robot.set_command(0.0, 0.0)
+            self._last_t = now
+            return
+        self._step(now)
+
+    def _on_pose_lockstep(self, msg: PoseStamped) -> None:
+        """Lockstep: the sim reached the granted time; act on its state there, then grant the next step."""
+        t = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        if self._granted is None or t + 1e-6 < self._granted:
+            return
+        self._granted, self._reached = None, t
+        self._step(t)
+        self._grant_when_ready()
+
+    def _grant_when_ready(self) -> None:
+        """Lockstep: the sim waits while captures are on their way (they are taken at this instant)."""
+        if self._reached is None or self._holding() or self.finished.done():
+            return
+        msg = TwistStamped()
+        msg.header.stamp = convert.stamp(self._reached + 1.0 / CONTROL_HZ)
+        msg.twist.linear.x, msg.twist.angular.z = self.robot.command
+        self._granted = self._reached + 1.0 / CONTROL_HZ
+        self._reached = None
+        self._step_pub.publish(msg)
+
+    def _step(self, now: float) -> None:
         dt = 1.0 / CONTROL_HZ if self._last_t is None else now - self._last_t
         self._last_t = now
-        if dt <= 0:
+        if dt <= 0 or self.finished.done():
             return
-        for reason in self.behaviour.update(dt):
-            future = self.capture_client.call_async(Trigger.Request())
-            self._pending.add(future)
-            future.add_done_callback(lambda f, r=reason: self._on_capture(f, r))
+        if not self.behaviour.done:
+            for reason in self.behaviour.update(dt):
+                future = self.capture_client.call_async(Trigger.Request())
+                self._pending.add(future)
+                future.add_done_callback(lambda f, r=reason: self._on_capture(f, r))
         if self.behaviour.done:
-            self.timer.cancel()
             self.robot.set_command(0.0, 0.0)
             self._finish_when_answered()
 
+    def _holding(self) -> bool:
+        """Captures in flight hold the robot: with --wait-recorder until recorded, in lockstep until
+        answered (so each is taken at the instant it was asked for)."""
+        return bool(self._unrecorded) or bool(self._pending) and (self.wait_recorder or self.lockstep)
+
+    def _check_recorder(self) -> None:
+        """Wall-clock timer: a capture the recorder never confirms ends the run loudly."""
+        for stamp, (_, deadline) in self._unrecorded.items():
+            if time.monotonic() > deadline:
+                raise UserError(f"the capture at t={stamp:.3f} s never reached a recorder within "
+                                f"{RECORD_TIMEOUT_S:.0f} s (is `ravh recorder` running?)")
+
     def _finish_when_answered(self) -> None:
-        """End once the behaviour is done and every capture it asked for has been answered."""
-        if self.behaviour.done and not self._pending and not self.finished.done():
-            self.get_logger().info(f"done: {len(self.captures)} captures, rooms {sorted(self._rooms_seen)}")
+        """End once the behaviour is done and every capture it asked for has been answered (and, with
+        --wait-recorder, recorded)."""
+        if self.behaviour.done and not self._pending and not self._unrecorded and not self.finished.done():
+            self.get_logger().info(f"done: {self.capture_count} captures, rooms {sorted(self._rooms_seen)}")
             self.finished.set_result(True)
 
     def _on_capture(self, future, reason: str) -> None:
         self._pending.discard(future)
-        self._record(future.result(), reason)
-        self._finish_when_answered()
-
-    def _record(self, result: Trigger.Response | None, reason: str) -> None:
+        result = future.result()
         if result is None or not result.success:
             self.get_logger().warning(f"capture failed: {getattr(result, 'message', 'no reply')}")
-            return
-        event = json.loads(result.message)
-        event["reason"] = reason
-        self.captures.append(event)
+        else:
+            event = json.loads(result.message)
+            event["reason"] = reason
+            if self.wait_recorder:
+                self._unrecorded[event["stamp"]] = (event, time.monotonic() + RECORD_TIMEOUT_S)
+            else:
+                self._record(event)
+        self._finish_when_answered()
+        self._grant_when_ready()
+
+    def _on_recorded(self, msg: String) -> None:
+        stamp = json.loads(msg.data)["stamp"]
+        if stamp in self._unrecorded:
+            self._record(self._unrecorded.pop(stamp)[0])
+            self._finish_when_answered()
+            self._grant_when_ready()
+
+    def _record(self, event: dict[str, Any]) -> None:
+        self.capture_count += 1
         if event.get("room"):
             self._rooms_seen.add(event["room"])
         x, y, yaw = event["pose"]
-        self.get_logger().info(f"capture {len(self.captures)} t={event['stamp']:.2f} pose=({x:.2f}, {y:.2f}, "
-                               f"{math.degrees(yaw):.0f} deg) room={event['room']} [{reason}]")
+        self.get_logger().info(f"capture {self.capture_count} t={event['stamp']:.2f} pose=({x:.2f}, {y:.2f}, "
+                               f"{math.degrees(yaw):.0f} deg) room={event['room']} [{event['reason']}]")
         if self._log_file:
             self._log_file.write(json.dumps(event) + "\n")
             self._log_file.flush()
@@ -181,4 +270,9 @@ def common_args(prog: str, description: str) -> argparse.ArgumentParser:
                    help=f"agent to drive (default {FIRST_AGENT}, whose topics have no prefix)")
     p.add_argument("--profile", default="giraff", help="robot profile of that agent")
     p.add_argument("--log", type=Path, help="append every capture (pose, room) to this JSON-lines file")
+    p.add_argument("--wait-recorder", action="store_true",
+                   help="count a capture only once a recorder stored it; hold still until then")
+    p.add_argument("--lockstep", action="store_true",
+                   help="drive a sim started with --lockstep: sim time advances only step by step as "
+                        "this behaviour grants it (reproducible runs)")
     return p

@@ -9,11 +9,14 @@ from __future__ import annotations
 import functools
 import os
 import sys
+import time
 from typing import Callable
 
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from ravh_sim.paths import FASTDDS_PROFILE
+
+SIM_LOST_S = 6.0        # wall seconds without /clock after which a sim counts as gone
 
 SENSOR_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=5, reliability=ReliabilityPolicy.RELIABLE,
                         durability=DurabilityPolicy.VOLATILE)
@@ -21,8 +24,46 @@ STATE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10, reliability=Re
                        durability=DurabilityPolicy.VOLATILE)
 LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1, reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
+# capture hand-over acknowledgements: none may be lost, and there are few of them
+HANDOVER_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE,
+                          durability=DurabilityPolicy.VOLATILE)
 COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.VOLATILE)
+
+
+def ros_domain_id(pick: int) -> tuple[str, str]:
+    """The ROS_DOMAIN_ID to run on and how it was chosen: the user's when set; otherwise one derived
+    from ``pick`` (a pid...), so parallel raids and test runs on one machine do not hear each other."""
+    user = os.environ.get("ROS_DOMAIN_ID", "").strip()
+    if user:
+        return user, "from the environment"
+    return str(1 + pick % 200), "chosen automatically; set ROS_DOMAIN_ID to choose"
+
+
+class SimWatchdog:
+    """Notices a sim that went away: no /clock for :data:`SIM_LOST_S` wall seconds once one arrived.
+
+    Nodes that run on sim time would otherwise wait for ever when the sim dies; the check runs on a
+    wall-clock timer and raises :class:`UserError`, which ends the node's spin with one clear line
+    and a non-zero exit (run_node)."""
+
+    def __init__(self, node) -> None:
+        from rclpy.clock import Clock, ClockType
+        from rosgraph_msgs.msg import Clock as ClockMsg
+
+        from ravh_msgs_py import names as n
+        self._last: float | None = None
+        node.create_subscription(ClockMsg, n.CLOCK, self._on_clock,
+                                 QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT))
+        node.create_timer(0.5, self._check, clock=Clock(clock_type=ClockType.STEADY_TIME))
+
+    def _on_clock(self, _msg) -> None:
+        self._last = time.monotonic()
+
+    def _check(self) -> None:
+        from ravh_sim.errors import UserError
+        if self._last is not None and time.monotonic() - self._last > SIM_LOST_S:
+            raise UserError(f"lost the sim: no /clock for {SIM_LOST_S:.0f} s (did `ravh sim` stop?)")
 
 
 def use_large_message_transport() -> None:
@@ -50,7 +91,8 @@ def quiet_after_shutdown(callback: Callable) -> Callable:
 
 
 def run_node(make_node: Callable[[list[str]], object], argv: list[str] | None = None) -> int:
-    """rclpy.init, build the node, spin until SIGINT, shut down cleanly. User errors print one line."""
+    """rclpy.init, build the node, spin until SIGINT, shut down cleanly. User errors print one line.
+    Returns 2 after a user error, else the node's ``exit_code`` after close (0 unless it failed)."""
     import rclpy
     from rclpy.executors import ExternalShutdownException
 
@@ -79,4 +121,4 @@ def run_node(make_node: Callable[[list[str]], object], argv: list[str] | None = 
                 close()
             node.destroy_node()
         rclpy.try_shutdown()
-    return 0
+    return getattr(node, "exit_code", 0)

@@ -20,7 +20,7 @@ def make_node(argv: list[str]) -> BehaviourNode:
         nodes = grid_nodes(layout, grid, start, args.spacing)
         return GridSweep(follower, nodes[:args.max_nodes] if args.max_nodes > 0 else nodes, args.captures)
 
-    return BehaviourNode("grid", make, args.agent, args.profile, args.log)
+    return BehaviourNode("grid", make, args.agent, args.profile, args.log, args.wait_recorder, args.lockstep)
 
 
 def main(argv: list[str] | None = None) -> int:

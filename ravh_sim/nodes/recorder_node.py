@@ -16,6 +16,11 @@ Bag times are sim receive times (``use_sim_time``); messages that arrive before 
 written at the first clock time. SIGINT closes the bag (metadata.yaml written); a SIGKILLed recorder
 leaves a dataset that reads back complete up to its last capture, and an MCAP without its summary
 (``mcap recover`` rebuilds it).
+
+Nothing is lost silently: each stored capture is confirmed on ``ravh/capture_recorded`` (reliable,
+keep-all), which a behaviour run with ``--wait-recorder`` waits for before it moves on; a capture that
+cannot be completed or written, or a sim that goes away (no /clock), ends the recorder with an error
+and a non-zero exit status after it has closed what it has.
 """
 from __future__ import annotations
 
@@ -29,6 +34,7 @@ from pathlib import Path
 from typing import Any, Callable, NamedTuple
 
 import numpy as np
+import rclpy.clock
 import rclpy.logging
 from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import OccupancyGrid, Odometry
@@ -49,10 +55,10 @@ from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nodes import convert
-from ravh_sim.nodes.common import LATCHED_QOS, SENSOR_QOS, STATE_QOS, run_node
+from ravh_sim.nodes.common import HANDOVER_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, SimWatchdog, run_node
 
 NS = 1_000_000_000
-PENDING_TIMEOUT_S = 10.0      # wall seconds a stamp's parts wait for the rest of their capture
+PENDING_TIMEOUT_S = 30.0      # wall seconds a stamp's parts wait for the rest of their capture
 MAX_PENDING = 32              # stamps buffered at most (periodic frames without an event go first)
 
 class Part(NamedTuple):
@@ -224,6 +230,10 @@ class RecorderNode(Node):
         self.matcher = StampMatcher({k for k, p in self.parts.items() if p.per_capture or p.dataset})
         self.agent: str | None = None
         self.captures = 0
+        self.lost = 0                                 # captures announced but never stored
+        self.failure: str | None = None               # the first write error (the worker thread's)
+        self.exit_code = 0
+        self.recorded_pub = None
         self.log = self.get_logger()
         self.topics: dict[str, str] = {}              # part -> resolved topic name
         for topic, (msg_type, in_dataset) in LATCHED.items():
@@ -238,6 +248,8 @@ class RecorderNode(Node):
                                            raw=True)
             self.bag.add_topic(sub.topic_name, msg_type, latched=False)
             self.topics[topic] = sub.topic_name
+        SimWatchdog(self)
+        self.create_timer(0.5, self._check_writes, clock=rclpy.clock.Clock(clock_type=rclpy.clock.ClockType.STEADY_TIME))
         self.log.info(f"waiting for {n.GROUND_TRUTH} to learn the house and its agents")
 
     # ------------------------------------------------------------------ set-up once the world is known
@@ -249,6 +261,8 @@ class RecorderNode(Node):
         if agent not in agents:
             raise UserError(f"unknown agent {agent!r}; the sim has {', '.join(agents)}")
         self.agent = agent
+        self.recorded_pub = self.create_publisher(String, n.agent_name(n.CAPTURE_RECORDED, agent, agent == agents[0]),
+                                                  HANDOVER_QOS)
         self._submit(self.writer.write_meta, footprint["house"], [agent], self.raid, self.bag is not None)
         for key, part in self.parts.items():
             name = n.agent_name(part.base, agent, agent == agents[0])
@@ -293,7 +307,8 @@ class RecorderNode(Node):
             return
         parts = self.matcher.add(stamp, key, value, time.monotonic())
         while self.matcher.lost:
-            self.log.warning(f"capture at t={self.matcher.lost.pop(0) / NS:.3f} s incomplete: dropped")
+            self.lost += 1
+            self.log.error(f"capture at t={self.matcher.lost.pop(0) / NS:.3f} s incomplete: lost")
         if parts is not None:
             self._complete(parts)
 
@@ -317,14 +332,30 @@ class RecorderNode(Node):
              "range_min": scan.range_min, "range_max": scan.range_max},
             camera_dict(msgs["rgb_info"]))
         self.captures = index + 1
+        self._confirm(event["stamp"], index)
         self.log.info(f"capture {index} at t={event['stamp']:.2f} s in {event['room']}")
+
+    def _confirm(self, stamp: float, index: int) -> None:
+        """Tell the behaviour its capture is stored (not possible any more once SIGINT shut ROS down)."""
+        try:
+            self.recorded_pub.publish(String(data=json.dumps({"stamp": stamp, "index": index})))
+        except Exception:
+            if self.context.ok():
+                raise
 
     def _submit(self, fn: Callable[..., object], *args: Any) -> None:
         self.worker.submit(fn, *args).add_done_callback(self._report)
 
     def _report(self, future: Future) -> None:
-        if future.exception() is not None:
-            self.log.error(f"dataset write failed: {future.exception()!r}")
+        error = future.exception()
+        if error is not None and self.failure is None:
+            self.failure = f"{error.strerror}: {error.filename}" if isinstance(error, OSError) else repr(error)
+
+    def _check_writes(self) -> None:
+        """A failed write ends the recording loudly (the worker thread cannot raise into the executor)."""
+        if self.failure is not None:
+            raise UserError(f"dataset write failed ({self.failure}); stopped with {self.captures} captures "
+                            f"in {self.out}")
 
     def close(self) -> None:
         """Finish queued writes, then close the dataset and the bag (SIGINT lands here)."""
@@ -335,8 +366,13 @@ class RecorderNode(Node):
         self.writer.close()
         if self.bag:
             self.bag.close()
-        self.log.info(f"stopped: {self.captures} captures in {self.out}"
-                      + (f", {waiting} incomplete dropped" if waiting else ""))
+        self.lost += waiting
+        if self.lost or self.failure:
+            self.exit_code = 1
+            self.log.error(f"stopped: {self.captures} captures in {self.out}; {self.lost} announced captures "
+                           f"lost" + (f"; a write failed: {self.failure}" if self.failure else ""))
+        else:
+            self.log.info(f"stopped: {self.captures} captures in {self.out}")
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:

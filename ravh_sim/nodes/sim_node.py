@@ -8,6 +8,8 @@ All names come from ``ravh_msgs_py.names``. Parameters are read-only (they shape
 ``map_tf`` (auto|on|off) says who owns the map -> odom edge on /tf: ``on`` the sim (ground truth),
 ``off`` someone else, ``auto`` (default) the sim only while no other node (slam_toolbox, AMCL)
 publishes that edge. The ground truth stays on ``map_to_odom`` and ``ground_truth/pose`` either way.
+With ``--lockstep`` it advances only as far as a behaviour grants on ``ravh/step`` (which carries the
+command for that step), so a run depends on sim time alone and repeats exactly with the same seed.
 Requests never take it down: bad commands are refused with a throttled warning, bad service
 requests get an error reply.
 """
@@ -38,7 +40,8 @@ from ravh_msgs_py import names as n
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nodes import convert
-from ravh_sim.nodes.common import COMMAND_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, quiet_after_shutdown, run_node
+from ravh_sim.nodes.common import (COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS,
+                                   quiet_after_shutdown, run_node)
 from ravh_sim.render.backend import BACKENDS
 from ravh_sim.runtime import Agent, Rates, SimRuntime
 from ravh_sim.sensors.imaging import encode_jpeg
@@ -55,8 +58,9 @@ TF_LISTEN_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT)
 PARAMETERS: dict[str, Any] = {
     "house": 15, "seed": -1, "config": "", "footprint": "", "renderer": "auto", "real_time_factor": 1.0,
     "camera_rate": 10.0, "scan_rate": 10.0, "odom_rate": 50.0, "clock_rate": 100.0,
-    "cmd_vel_stamped": False, "map_tf": "auto",
+    "cmd_vel_stamped": False, "map_tf": "auto", "lockstep": False,
 }
+HEARTBEAT_S = 0.5                       # lockstep: wall period of /clock and pose while waiting
 
 
 class SimNode(Node):
@@ -71,7 +75,7 @@ class SimNode(Node):
         self.map_tf = str(p["map_tf"])
         if self.map_tf not in MAP_TF_MODES:
             raise UserError(f"map_tf must be one of {', '.join(MAP_TF_MODES)}, got {self.map_tf!r}")
-        self.runtime = SimRuntime(int(p["house"]), p["config"] or None, None if p["seed"] < 0 else int(p["seed"]),
+        self.runtime = SimRuntime(int(p["house"]), p["config"] or None, None if p["seed"] == -1 else p["seed"],
                                   renderer=p["renderer"],
                                   rates=Rates(p["camera_rate"], p["scan_rate"], p["odom_rate"], p["clock_rate"]),
                                   footprint=p["footprint"] or None)
@@ -79,6 +83,8 @@ class SimNode(Node):
         self.get_logger().info(
             f"house {rt.house.number}: {len(rt.house.rooms)} rooms, {len(rt.house.objects)} objects, "
             f"renderer {rt.world.renderer}, seed {rt.world.settings.seed}, real-time factor {self.rtf:g}")
+        self.lockstep = bool(p["lockstep"])
+        self._allowed, self._heartbeat = rt.time, 0.0     # lockstep: sim time granted; last wall beat
         self._make_publishers()
         self._make_subscriptions(bool(p["cmd_vel_stamped"]))
         self._make_services()
@@ -137,6 +143,9 @@ class SimNode(Node):
                                          lambda m, a=agent: self._on_cmd(a, m.twist), COMMAND_QOS)
             else:
                 self.create_subscription(Twist, topic, lambda m, a=agent: self._on_cmd(a, m), COMMAND_QOS)
+            if self.lockstep:
+                self.create_subscription(TwistStamped, n.agent_name(n.STEP, agent.name, agent.first),
+                                         lambda m, a=agent: self._on_step(a, m), HANDOVER_QOS)
 
     def _make_services(self) -> None:
         srv = self.create_service
@@ -160,13 +169,32 @@ class SimNode(Node):
             target = min(target, rt.time + MAX_STEP_S)
         else:
             target = rt.time + MAX_STEP_S
+        if self.lockstep:
+            target = min(target, self._allowed)
         deadline = time.monotonic() + MAX_STEP_S
         while rt.time + 1e-9 < target and time.monotonic() < deadline:
             self._watchdog()
             rt.step()
             self._publish_due()
+        if self.lockstep and rt.time + 1e-9 >= self._allowed and time.monotonic() - self._heartbeat > HEARTBEAT_S:
+            self._arrived()
         if self.rtf > 0 and rt.time + MAX_STEP_S < self._sim0 + self.rtf * (time.monotonic() - self._wall0):
             self._wall0, self._sim0 = time.monotonic(), rt.time       # fell behind: do not try to catch up
+
+    def _on_step(self, agent: Agent, msg: TwistStamped) -> None:
+        """Lockstep: the behaviour's command for the next step and the sim time it may run to."""
+        self._on_cmd(agent, msg.twist)
+        self._allowed = max(self._allowed, msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9)
+        self._heartbeat = 0.0
+
+    def _arrived(self) -> None:
+        """Lockstep: at the granted time, the pose the behaviour acts on (repeated while waiting, with
+        /clock, so late subscribers get it and nobody takes the pause for a dead sim)."""
+        rt, self._heartbeat = self.runtime, time.monotonic()
+        self.clock_pub.publish(convert.clock(rt.time))
+        for agent in rt.agents:
+            self.agent_pubs[agent.name]["gt_pose"].publish(convert.pose_stamped(agent.robot.pose,
+                                                                                convert.header(rt.time, n.MAP_FRAME)))
 
     def _watchdog(self) -> None:
         for agent in self.runtime.agents:
@@ -355,13 +383,13 @@ class SimNode(Node):
         start = (request.start.pose.position.x, request.start.pose.position.y)
         goal = (request.goal.pose.position.x, request.goal.pose.position.y)
         response.plan.header = convert.header(self._now(), n.MAP_FRAME)
-        if not all(math.isfinite(v) for v in (*start, *goal)):
-            self._warn("GetPlan: rejected non-finite start or goal")
-            return response
         try:
-            path = rt.navigation.plan(start, goal)
+            path = rt.plan(start, goal)
         except UserError as e:
             self._warn(f"GetPlan: {e}")
+            return response
+        except Exception as e:  # never die from a request
+            self._warn(f"GetPlan: {type(e).__name__}: {e}")
             return response
         pts = path.points
         for i, (x, y) in enumerate(pts):
@@ -414,6 +442,8 @@ def parse_args(argv: list[str]) -> dict[str, Any]:
     p.add_argument("--map-tf", dest="map_tf", choices=MAP_TF_MODES,
                    help="who publishes map -> odom on /tf: auto (default: the sim unless another node "
                         "does), on (always the sim), off (never the sim)")
+    p.add_argument("--lockstep", action="store_true", default=None,
+                   help="advance sim time only as far as a behaviour grants on ravh/step (reproducible runs)")
     args = p.parse_args(argv)
     return {k: v for k, v in vars(args).items() if v is not None}
 

@@ -21,7 +21,7 @@ def make_node(argv: list[str]) -> BehaviourNode:
         return Wanderer(follower, light_waypoints(layout, grid, start), args.order, args.capture_period,
                         args.seed)
 
-    return BehaviourNode("wanderer", make, args.agent, args.profile, args.log)
+    return BehaviourNode("wanderer", make, args.agent, args.profile, args.log, args.wait_recorder, args.lockstep)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,20 +1,23 @@
 """Robot profiles (``config/robots/*.yaml``): body, motion limits and sensor mounting in one place.
 
-Loaded into frozen dataclasses so every consumer (physics, sensors, navigation, nodes) reads the same
-validated numbers; a bad value names the file and the field.
+Validated by a pydantic schema (every field typed and bounded) and loaded into frozen dataclasses, so
+every consumer (physics, sensors, navigation, nodes) reads the same checked numbers; a bad value names
+the file and the field.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import yaml
+from pydantic import Field, model_validator
 
 from ravh_sim.errors import FileFieldError, UnknownNameError
 from ravh_sim.paths import ROBOTS_DIR
 from ravh_sim.render.backend import QUALITIES
+from ravh_sim.schema import Strict, number, read_text, validate, vector
 
 
 @dataclass(frozen=True)
@@ -90,6 +93,87 @@ def available_profiles() -> list[str]:
     return sorted(p.stem for p in ROBOTS_DIR.glob("*.yaml"))
 
 
+# bounds: anything a real mobile robot could have; beyond them a value is a slip (a 1e6 m radius,
+# a 1e-7 degree laser resolution that would allocate gigabytes, a 0.5 px camera)
+Length = number(gt=0.0, le=10.0)           # m, body and mounting
+Rate = number(gt=0.0, le=1000.0)           # Hz
+Sigma = number(ge=0.0, le=10.0)
+Range = number(gt=0.0, le=1000.0)          # m
+Pixels = Annotated[int, Field(ge=16, le=8192)]
+
+
+class _Noise(Strict):
+    linear_sigma: Sigma
+    angular_sigma: Sigma
+
+
+class _Laser(Strict):
+    height: Length
+    fov: number(gt=0.0, le=360.0)
+    resolution: number(ge=0.01, le=360.0)
+    range_min: Range
+    range_max: Range
+    rate: Rate
+    noise_sigma: Sigma
+
+    @model_validator(mode="after")
+    def _ordered(self) -> _Laser:
+        if self.range_min >= self.range_max:
+            raise ValueError(f"range_min {self.range_min} must be below range_max {self.range_max}")
+        if self.resolution > self.fov:
+            raise ValueError(f"resolution {self.resolution} is wider than fov {self.fov}")
+        return self
+
+
+class _Effects(Strict):
+    """The bounds of the realism effects the profile sets; their defaults live in sensors.camera.CameraOptions."""
+    jpeg_quality: Annotated[int, Field(ge=1, le=100)] = None
+    jpeg_roundtrip: bool = None
+    pixel_noise: number(ge=0.0, le=255.0) = None
+    distortion: vector(number(ge=-10.0, le=10.0), 5) | None = None
+    motion_blur: bool = None
+    exposure: number(gt=0.0, le=1.0) = None
+    depth_noise: number(ge=0.0, le=1.0) = None
+    manual_exposure: number(gt=0.0, le=100.0) | None = None
+
+
+class _Camera(Strict):
+    height: Length
+    pitch: number(ge=-90.0, le=90.0)
+    forward: number(ge=-10.0, le=10.0)
+    width: Pixels
+    height_px: Pixels
+    sensor_width: number(gt=0.0, le=100.0)     # mm
+    sensor_height: number(gt=0.0, le=100.0)
+    focal_length: number(gt=0.0, le=1000.0)
+    near: Range
+    far: Range
+    rate: Rate
+    quality: Literal[QUALITIES] = "realistic"         # type: ignore[valid-type]
+    effects: _Effects = _Effects()
+
+    @model_validator(mode="after")
+    def _ordered(self) -> _Camera:
+        if self.near >= self.far:
+            raise ValueError(f"near {self.near} must be below far {self.far}")
+        return self
+
+
+class ProfileFile(Strict):
+    """The schema of config/robots/*.yaml."""
+    name: Annotated[str, Field(min_length=1, max_length=64)]
+    footprint_radius: Length
+    height: Length
+    mass: number(gt=0.0, le=10_000.0)
+    max_linear_speed: number(gt=0.0, le=10.0)             # m/s
+    max_angular_speed: number(gt=0.0, le=1000.0)          # deg/s
+    max_linear_acceleration: number(gt=0.0, le=100.0)     # m/s^2
+    max_angular_acceleration: number(gt=0.0, le=10_000.0) # deg/s^2
+    odometry_noise: _Noise
+    laser: _Laser
+    camera: _Camera
+
+
 def load_profile(name_or_path: str | Path = "giraff") -> RobotProfile:
     path = Path(name_or_path)
     if path.suffix not in (".yaml", ".yml"):
@@ -97,79 +181,20 @@ def load_profile(name_or_path: str | Path = "giraff") -> RobotProfile:
         if not path.exists():
             raise UnknownNameError("robot profile", str(name_or_path), available_profiles())
     try:
-        data = yaml.safe_load(path.read_text())
-    except (OSError, yaml.YAMLError) as e:
-        raise FileFieldError(path, "-", f"cannot read robot profile: {e}") from None
-    f = _Reader(data, str(path))
-    lz, cam = f.sub("laser"), f.sub("camera")
-    noise = f.sub("odometry_noise")
+        data = yaml.safe_load(read_text(path, "robot profile"))
+    except (yaml.YAMLError, RecursionError) as e:
+        raise FileFieldError(path, "(top level)", f"invalid YAML: {type(e).__name__}") from None
+    f = validate(ProfileFile, data, path)
+    lz, cam, effects = f.laser, f.camera, f.camera.effects
     return RobotProfile(
-        name=str(data.get("name", path.stem)), radius=f.pos("footprint_radius"), height=f.pos("height"),
-        mass=f.pos("mass"), max_linear_speed=f.pos("max_linear_speed"),
-        max_angular_speed=math.radians(f.pos("max_angular_speed")),
-        max_linear_acceleration=f.pos("max_linear_acceleration"),
-        max_angular_acceleration=math.radians(f.pos("max_angular_acceleration")),
-        odom_linear_sigma=noise.nonneg("linear_sigma"),
-        odom_angular_sigma=math.radians(noise.nonneg("angular_sigma")),
-        laser=LaserSpec(lz.pos("height"), lz.pos("fov"), lz.pos("resolution"), lz.pos("range_min"),
-                        lz.pos("range_max"), lz.pos("rate"), lz.nonneg("noise_sigma")),
-        camera=CameraSpec(cam.pos("height"), cam.num("pitch"), cam.num("forward"), int(cam.pos("width")),
-                          int(cam.pos("height_px")), cam.pos("sensor_width"), cam.pos("sensor_height"),
-                          cam.pos("focal_length"), cam.pos("near"), cam.pos("far"), cam.pos("rate"),
-                          cam.choice("quality", QUALITIES, "realistic")),
-        camera_effects=_effects(data.get("camera", {}).get("effects") or {}, str(path)),
+        name=f.name, radius=f.footprint_radius, height=f.height, mass=f.mass,
+        max_linear_speed=f.max_linear_speed, max_angular_speed=math.radians(f.max_angular_speed),
+        max_linear_acceleration=f.max_linear_acceleration,
+        max_angular_acceleration=math.radians(f.max_angular_acceleration),
+        odom_linear_sigma=f.odometry_noise.linear_sigma,
+        odom_angular_sigma=math.radians(f.odometry_noise.angular_sigma),
+        laser=LaserSpec(lz.height, lz.fov, lz.resolution, lz.range_min, lz.range_max, lz.rate, lz.noise_sigma),
+        camera=CameraSpec(cam.height, cam.pitch, cam.forward, cam.width, cam.height_px, cam.sensor_width,
+                          cam.sensor_height, cam.focal_length, cam.near, cam.far, cam.rate, cam.quality),
+        camera_effects=tuple(sorted(effects.model_dump(exclude_unset=True).items())),
     )
-
-
-def _effects(effects: Any, source: str) -> tuple[tuple[str, Any], ...]:
-    """The camera's realism effects, checked against CameraOptions so a typo names file and key."""
-    from ravh_sim.sensors.camera import CameraOptions
-    if not isinstance(effects, dict):
-        raise FileFieldError(source, "camera.effects", "expected a mapping of effect: value")
-    valid = set(CameraOptions.__dataclass_fields__)
-    for key in effects:
-        if key not in valid:
-            raise FileFieldError(source, f"camera.effects.{key}", f"unknown effect; valid: {', '.join(sorted(valid))}")
-    try:
-        CameraOptions(**effects)
-    except (TypeError, ValueError) as e:
-        raise FileFieldError(source, "camera.effects", str(e)) from None
-    return tuple(sorted((k, tuple(v) if isinstance(v, list) else v) for k, v in effects.items()))
-
-
-class _Reader:
-    def __init__(self, data: Any, source: str, prefix: str = "") -> None:
-        if not isinstance(data, dict):
-            raise FileFieldError(source, prefix or "(top level)", "expected a mapping")
-        self.data, self.source, self.prefix = data, source, prefix
-
-    def sub(self, key: str) -> _Reader:
-        return _Reader(self.data.get(key), self.source, f"{self.prefix}{key}")
-
-    def num(self, key: str) -> float:
-        value = self.data.get(key)
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise FileFieldError(self.source, f"{self.prefix and self.prefix + '.'}{key}",
-                                 f"expected a finite number, got {value!r}")
-        return float(value)
-
-    def pos(self, key: str) -> float:
-        value = self.num(key)
-        if value <= 0:
-            raise FileFieldError(self.source, f"{self.prefix and self.prefix + '.'}{key}",
-                                 f"must be > 0, got {value}")
-        return value
-
-    def choice(self, key: str, options: tuple[str, ...], default: str) -> str:
-        value = self.data.get(key, default)
-        if value not in options:
-            raise FileFieldError(self.source, f"{self.prefix and self.prefix + '.'}{key}",
-                                 f"expected one of {', '.join(options)}, got {value!r}")
-        return str(value)
-
-    def nonneg(self, key: str) -> float:
-        value = self.num(key)
-        if value < 0:
-            raise FileFieldError(self.source, f"{self.prefix and self.prefix + '.'}{key}",
-                                 f"must be >= 0, got {value}")
-        return value

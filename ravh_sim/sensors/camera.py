@@ -20,6 +20,7 @@ import cv2
 import numpy as np
 import pybullet as pb
 
+from ravh_sim.files import atomic_write, write_image
 from ravh_sim.render.gl_renderer import GLRenderer
 from ravh_sim.render.projection import SAMPLE_OFFSET, projection_from_K, view_matrix
 from ravh_sim.robot.profile import CameraSpec
@@ -234,9 +235,9 @@ def write_capture(camera: SmartCamera, capture: Capture, directory: Path) -> lis
     info.json (K, poses, the instances in view with their pixel counts) in ``directory``."""
     directory.mkdir(parents=True, exist_ok=True)
     paths = [directory / name for name in ("rgb.png", "depth.png", "mask.png", "info.json")]
-    cv2.imwrite(str(paths[0]), cv2.cvtColor(capture.rgb, cv2.COLOR_RGB2BGR))
-    cv2.imwrite(str(paths[1]), imaging.depth_to_png(capture.depth))
-    cv2.imwrite(str(paths[2]), cv2.cvtColor(camera.instance_color(capture), cv2.COLOR_RGB2BGR))
+    write_image(paths[0], cv2.cvtColor(capture.rgb, cv2.COLOR_RGB2BGR))
+    write_image(paths[1], imaging.depth_to_png(capture.depth))
+    write_image(paths[2], cv2.cvtColor(camera.instance_color(capture), cv2.COLOR_RGB2BGR))
     counts = np.bincount(capture.instance.ravel())
     by_id = {inst.id: inst for inst in camera.world.instances}
     visible = [{"id": int(i), "name": by_id[i].name, "kind": by_id[i].kind, "type": by_id[i].type,
@@ -250,5 +251,5 @@ def write_capture(camera: SmartCamera, capture: Capture, directory: Path) -> lis
             "lights_on": sorted(k for k, on in camera.world.settings.lights.items() if on),
             "depth_png": "uint16 millimetres along the optical axis, 0 = no depth",
             "pixels_without_instance": int(counts[0]), "instances": visible}
-    paths[3].write_text(json.dumps(info, indent=1) + "\n")
+    atomic_write(paths[3], (json.dumps(info, indent=1) + "\n").encode())
     return paths

@@ -40,6 +40,7 @@ from typing import Callable, Mapping, Sequence
 import cv2
 import numpy as np
 
+from ravh_sim.files import write_image
 from ravh_sim.nav.grid import FREE, Grid
 from ravh_sim.world.geometry import box_corners
 from ravh_sim.world.house import Door, House, HouseObject, ModelBox, Room, Window
@@ -419,8 +420,7 @@ def write_plan(path: str | Path, image: np.ndarray) -> None:
     """Save a plan picture (format from the suffix, e.g. .png), creating parent folders."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    if not cv2.imwrite(str(path), image):
-        raise OSError(f"cannot write image {path}")
+    write_image(path, image)
 
 
 @dataclass(frozen=True)

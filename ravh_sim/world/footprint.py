@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from ravh_sim.errors import FileFieldError
+from ravh_sim.files import atomic_write
 from ravh_sim.world.geometry import polygon_centroid, quaternion_from_yaw
 from ravh_sim.world.house import House
 from ravh_sim.world.settings import Resolved
@@ -102,7 +103,7 @@ def dump_footprint(footprint: dict[str, Any]) -> str:
 
 def write_footprint(footprint: dict[str, Any], path: Path) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(dump_footprint(footprint))
+    atomic_write(path, dump_footprint(footprint).encode())
 
 
 def load_footprint(path: Path) -> tuple[int, Resolved]:

@@ -43,6 +43,45 @@ def points_in_polygon(xs: np.ndarray, ys: np.ndarray, poly: Polygon) -> np.ndarr
     return inside
 
 
+def distance_to_polygon(x: float, y: float, poly: Polygon) -> float:
+    """Distance from (x, y) to the outline of ``poly`` (0 on an edge)."""
+    return min(_distance_to_segment(x, y, a, b) for a, b in zip(poly, poly[1:] + poly[:1]))
+
+
+def _distance_to_segment(x: float, y: float, a, b) -> float:
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    length2 = dx * dx + dy * dy
+    t = 0.0 if length2 == 0 else max(0.0, min(1.0, ((x - a[0]) * dx + (y - a[1]) * dy) / length2))
+    return math.hypot(x - a[0] - t * dx, y - a[1] - t * dy)
+
+
+def self_intersection(poly: Polygon) -> tuple[int, int] | None:
+    """The first pair of non-adjacent edges (i, j) that cross or touch; None for a simple polygon."""
+    n = len(poly)
+    edges = [(poly[i], poly[(i + 1) % n]) for i in range(n)]
+    for i in range(n):
+        for j in range(i + 2, n):
+            if i == 0 and j == n - 1:
+                continue                       # the closing edge meets the first one at a vertex
+            if _segments_meet(*edges[i], *edges[j]):
+                return i, j
+    return None
+
+
+def _segments_meet(a, b, c, d) -> bool:
+    d1, d2, d3, d4 = _cross(c, d, a), _cross(c, d, b), _cross(a, b, c), _cross(a, b, d)
+    if (d1 > 0) != (d2 > 0) and (d3 > 0) != (d4 > 0) and 0 not in (d1, d2, d3, d4):
+        return True
+    return any(abs(o) < 1e-12 and _on_segment(p, q, r) for o, p, q, r in (
+        (d1, c, d, a), (d2, c, d, b), (d3, a, b, c), (d4, a, b, d)))
+
+
+def _on_segment(p, q, r) -> bool:
+    """r lies within the bounding box of segment pq (r is known to be collinear)."""
+    return min(p[0], q[0]) - 1e-12 <= r[0] <= max(p[0], q[0]) + 1e-12 and \
+        min(p[1], q[1]) - 1e-12 <= r[1] <= max(p[1], q[1]) + 1e-12
+
+
 def polygon_centroid(poly: Polygon) -> tuple[float, float]:
     """Area centroid (falls back to the vertex mean for degenerate polygons)."""
     a = cx = cy = 0.0

@@ -11,14 +11,19 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Annotated, Any, Iterator, Literal
 
-from ravh_sim.errors import FileFieldError, UnknownNameError
+from pydantic import AfterValidator, Field, model_validator
+
+from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
 from ravh_sim.paths import HOUSES_DIR
-from ravh_sim.world.geometry import Polygon, point_in_polygon, polygon_area
+from ravh_sim.schema import Strict, number, read_text, shown, validate, vector
+from ravh_sim.world.geometry import (Polygon, distance_to_polygon, point_in_polygon, polygon_area,
+                                     self_intersection)
 
 HOUSE_FORMAT = "ravh_sim/house@1"
 LIGHT_KINDS = ("ceiling", "lamp", "wall")
@@ -180,6 +185,21 @@ class House:
                 return room
         return None
 
+    def room_at_or_raise(self, x: float, y: float) -> Room:
+        """The room at (x, y); outside every room a UserError names the nearest one."""
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise UserError(f"({x}, {y}) is not a finite position")
+        room = self.room_at(x, y)
+        if room is None:
+            raise UserError(f"({x:.3g}, {y:.3g}) is outside every room of house {self.number}; "
+                            f"nearest room: {self.nearest_room(x, y).id}")
+        return room
+
+    def nearest_room(self, x: float, y: float) -> Room:
+        """The room whose floor outline is closest to (x, y) (for errors about points outside)."""
+        return min(self.rooms, key=lambda r: min(distance_to_polygon(x, y, p)
+                                                 for p in (r.floor, *r.extra_floors)))
+
     @property
     def bounds(self) -> tuple[float, float, float, float]:
         """(xmin, ymin, xmax, ymax) of every floor and wall."""
@@ -214,209 +234,235 @@ def load_house(house: int | str | Path, houses_dir: Path = HOUSES_DIR) -> House:
         path = house_path(number, houses_dir)
         if not path.exists():
             raise UnknownNameError("house", number, available_houses(houses_dir))
+    text = read_text(path, "house file")
     try:
-        data = json.loads(path.read_text())
+        data = json.loads(text)
     except json.JSONDecodeError as e:
         raise FileFieldError(path, f"line {e.lineno} column {e.colno}", f"invalid JSON: {e.msg}") from None
-    except OSError as e:
-        raise FileFieldError(path, "-", f"cannot read: {e.strerror}") from None
-    return house_from_dict(data, str(path))
+    except RecursionError:
+        raise FileFieldError(path, "(top level)", "nested too deeply") from None
+    house = house_from_dict(data, str(path))
+    named = re.fullmatch(r"house(\d\d)\.json", path.name)
+    if named and int(named[1]) != house.number:
+        raise FileFieldError(path, "house", f"{house.number} disagrees with the file name {path.name}")
+    return house
+
+
+# bounds that no real house comes near, so a unit or typing slip (1e12, 1e30) is refused at load
+EXTENT = 1000.0            # m, |coordinate|
+SIZE = 100.0               # m, any object, door or window dimension
+Coord = number(ge=-EXTENT, le=EXTENT)
+Size = number(gt=0.0, le=SIZE)
+Yaw = number(ge=-4 * math.pi, le=4 * math.pi)
+Id = Annotated[str, Field(min_length=1, max_length=200)]
+P2 = vector(Coord, 2)
+P3 = vector(Coord, 3)
+
+
+MIN_FLOOR_AREA = 1e-4      # m^2
+
+
+def _simple_polygon(points: list) -> list:
+    if polygon_area(tuple(points)) < MIN_FLOOR_AREA:
+        raise ValueError(f"zero-area floor (below {MIN_FLOOR_AREA} m^2)")
+    crossing = self_intersection(tuple(points))
+    if crossing:
+        raise ValueError(f"self-intersecting outline (edges {crossing[0]} and {crossing[1]} meet)")
+    return points
+
+
+FloorOutline = Annotated[list[P2], Field(min_length=3, max_length=10_000), AfterValidator(_simple_polygon)]
+
+
+class _Room(Strict):
+    id: Id
+    type: Id
+    name: Id
+    floor: FloorOutline
+    extra_floors: list[FloorOutline] = []
+    floor_z: Coord
+    ceiling_z: Coord
+
+    @model_validator(mode="after")
+    def _ceiling_above_floor(self) -> _Room:
+        if self.ceiling_z <= self.floor_z:
+            raise ValueError(f"ceiling_z {self.ceiling_z} must be above floor_z {self.floor_z}")
+        return self
+
+
+class _Wall(Strict):
+    room: Id
+    kind: Literal[WALL_KINDS]
+    a: P2
+    b: P2
+    thickness: Size
+    z0: Coord
+    z1: Coord
+
+    @model_validator(mode="after")
+    def _proper(self) -> _Wall:
+        if math.dist(self.a, self.b) < 1e-6:
+            raise ValueError("zero-length wall (a == b)")
+        if self.z1 <= self.z0:
+            raise ValueError(f"z1 {self.z1} must be above z0 {self.z0}")
+        return self
+
+
+class _Door(Strict):
+    id: Id
+    rooms: Annotated[list[Id], Field(min_length=1, max_length=2)]
+    position: P3
+    yaw: Yaw
+    width: Size
+    height: Size
+    thickness: Size
+    leaf: vector(Size, 3)
+    default_open: bool
+
+
+class _Window(Strict):
+    id: Id
+    room: Id
+    position: P3
+    yaw: Yaw
+    width: Size
+    height: Size
+    thickness: Size
+
+
+Channel = number(ge=0.0, le=1.0)
+
+
+class _Light(Strict):
+    id: Id
+    kind: Literal[LIGHT_KINDS]
+    room: Id
+    position: P3
+    intensity: number(ge=0.0, le=100.0)
+    range: number(gt=0.0, le=EXTENT)
+    color: vector(Channel, 3)
+
+
+class _ModelBox(Strict):
+    position: P3
+    size: vector(Size, 3)
+
+
+class _Object(Strict):
+    id: Id
+    type: Id
+    tags: Annotated[list[Id], Field(min_length=1)]
+    room: Id
+    prefab: Id
+    yaw: Yaw
+    size_estimated: bool
+    default_model: Annotated[int, Field(ge=0)]
+    models: Annotated[list[_ModelBox], Field(min_length=1)]
+    inherits_model_from: Id | None = None
+
+    @model_validator(mode="after")
+    def _consistent(self) -> _Object:
+        if self.default_model >= len(self.models):
+            raise ValueError(f"default_model must index models (0..{len(self.models) - 1}), "
+                             f"got {self.default_model}")
+        if self.type != self.tags[0]:
+            raise ValueError(f"type must equal the first tag {self.tags[0]!r}, got {self.type!r}")
+        return self
+
+
+class _Station(Strict):
+    position: P3
+    yaw: Yaw
+    object_id: Id
+
+
+class HouseFile(Strict):
+    """The schema of a house file (houses/README.md); cross-references are checked after it."""
+    format: Literal[HOUSE_FORMAT]
+    house: Annotated[int, Field(ge=1, le=99)]
+    attribution: str = ""
+    source: dict[str, str] = {}
+    station: _Station
+    rooms: Annotated[list[_Room], Field(min_length=1)]
+    walls: list[_Wall]
+    doors: list[_Door]
+    windows: list[_Window]
+    lights: list[_Light]
+    objects: list[_Object]
 
 
 def house_from_dict(data: Any, source: str) -> House:
-    """Build a :class:`House` from its JSON form, validating every field."""
-    root = _Fields(data, source, "")
-    fmt = root.str("format")
-    if fmt != HOUSE_FORMAT:
-        root.fail("format", f"expected {HOUSE_FORMAT!r}, got {fmt!r}")
-    rooms = tuple(_room(f) for f in root.items("rooms"))
-    room_ids = [r.id for r in rooms]
-    _unique(root, "rooms", room_ids)
-    walls = tuple(_wall(f, room_ids) for f in root.items("walls"))
-    objects = tuple(_object(f, room_ids) for f in root.items("objects"))
-    object_ids = [o.id for o in objects]
-    _unique(root, "objects", object_ids)
-    for i, obj in enumerate(objects):
-        if obj.inherits_model_from is not None and obj.inherits_model_from not in object_ids:
-            root.fail(f"objects[{i}].inherits_model_from", f"unknown object {obj.inherits_model_from!r}")
-    doors = tuple(_door(f, room_ids, object_ids) for f in root.items("doors"))
-    windows = tuple(_window(f, room_ids, object_ids) for f in root.items("windows"))
-    lights = tuple(_light(f, room_ids, object_ids) for f in root.items("lights"))
-    st = root.sub("station")
-    station = Station(st.vec("position", 3), st.num("yaw"), st.ref("object_id", object_ids))
-    return House(number=root.int("house"), rooms=rooms, walls=walls, doors=doors, windows=windows,
-                 lights=lights, objects=objects, station=station,
-                 source=root.get("source", {}))
+    """Build a :class:`House` from its JSON form: the schema checks every field, then the ids."""
+    f = validate(HouseFile, data, source)
+    room_ids = _unique(source, "rooms", [r.id for r in f.rooms])
+    object_ids = _unique(source, "objects", [o.id for o in f.objects])
+    refs = _References(source, room_ids, object_ids)
+    for i, w in enumerate(f.walls):
+        refs.room(f"walls[{i}].room", w.room)
+    for i, o in enumerate(f.objects):
+        refs.room(f"objects[{i}].room", o.room)
+        if o.inherits_model_from is not None:
+            refs.object(f"objects[{i}].inherits_model_from", o.inherits_model_from)
+    for i, d in enumerate(f.doors):
+        refs.object(f"doors[{i}].id", d.id)
+        for j, r in enumerate(d.rooms):
+            refs.room(f"doors[{i}].rooms[{j}]", r)
+    for kind, items in (("windows", f.windows), ("lights", f.lights)):
+        for i, item in enumerate(items):
+            refs.object(f"{kind}[{i}].id", item.id)
+            refs.room(f"{kind}[{i}].room", item.room)
+    refs.object("station.object_id", f.station.object_id)
+    rooms = tuple(Room(r.id, r.type, r.name, _poly(r.floor), tuple(_poly(p) for p in r.extra_floors),
+                       r.floor_z, r.ceiling_z) for r in f.rooms)
+    house = House(
+        number=f.house, rooms=rooms,
+        walls=tuple(Wall(w.a, w.b, w.thickness, w.z0, w.z1, w.room, w.kind) for w in f.walls),
+        doors=tuple(Door(d.id, d.position, d.yaw, d.width, d.height, d.thickness, d.leaf, tuple(d.rooms),
+                         d.default_open) for d in f.doors),
+        windows=tuple(Window(w.id, w.position, w.yaw, w.width, w.height, w.thickness, w.room)
+                      for w in f.windows),
+        lights=tuple(Light(lt.id, lt.kind, lt.position, lt.intensity, lt.range, lt.color, lt.room)
+                     for lt in f.lights),
+        objects=tuple(_object(o) for o in f.objects),
+        station=Station(f.station.position, f.station.yaw, f.station.object_id),
+        source=dict(f.source))
+    if house.room_at(*f.station.position[:2]) is None:
+        raise FileFieldError(source, "station.position", "outside every room")
+    return house
 
 
-def _room(f: _Fields) -> Room:
-    return Room(id=f.str("id"), type=f.str("type"), name=f.str("name"), floor=f.polygon("floor"),
-                extra_floors=tuple(f.polygon(f"extra_floors[{i}]", v)
-                                   for i, v in enumerate(f.list("extra_floors", []))),
-                floor_z=f.num("floor_z"), ceiling_z=f.num("ceiling_z"))
+def _poly(points: list) -> Polygon:
+    return tuple(tuple(p) for p in points)
 
 
-def _wall(f: _Fields, rooms: list[str]) -> Wall:
-    return Wall(a=f.vec("a", 2), b=f.vec("b", 2), thickness=f.positive("thickness"),
-                z0=f.num("z0"), z1=f.num("z1"), room=f.ref("room", rooms),
-                kind=f.choice("kind", WALL_KINDS))
+def _object(o: _Object) -> HouseObject:
+    models = tuple(ModelBox(m.position, m.size) for m in o.models)
+    default = models[o.default_model]
+    return HouseObject(id=o.id, type=o.type, tags=tuple(o.tags), room=o.room, prefab=o.prefab,
+                       position=default.position, yaw=o.yaw, size=default.size,
+                       size_estimated=o.size_estimated, models=models, default_model=o.default_model,
+                       inherits_model_from=o.inherits_model_from)
 
 
-def _door(f: _Fields, rooms: list[str], objects: list[str]) -> Door:
-    door_rooms = tuple(f.ref(f"rooms[{i}]", rooms, v) for i, v in enumerate(f.list("rooms")))
-    if not 1 <= len(door_rooms) <= 2:
-        f.fail("rooms", f"a door joins one or two rooms, got {len(door_rooms)}")
-    return Door(id=f.ref("id", objects), position=f.vec("position", 3), yaw=f.num("yaw"),
-                width=f.positive("width"), height=f.positive("height"),
-                thickness=f.positive("thickness"), leaf=f.vec("leaf", 3, positive=True),
-                rooms=door_rooms, default_open=f.bool("default_open"))
-
-
-def _window(f: _Fields, rooms: list[str], objects: list[str]) -> Window:
-    return Window(id=f.ref("id", objects), position=f.vec("position", 3), yaw=f.num("yaw"),
-                  width=f.positive("width"), height=f.positive("height"),
-                  thickness=f.positive("thickness"), room=f.ref("room", rooms))
-
-
-def _light(f: _Fields, rooms: list[str], objects: list[str]) -> Light:
-    return Light(id=f.ref("id", objects), kind=f.choice("kind", LIGHT_KINDS),
-                 position=f.vec("position", 3), intensity=f.nonnegative("intensity"),
-                 range=f.positive("range"), color=f.vec("color", 3), room=f.ref("room", rooms))
-
-
-def _object(f: _Fields, rooms: list[str]) -> HouseObject:
-    tags = tuple(f.str(f"tags[{i}]", v) for i, v in enumerate(f.list("tags")))
-    if not tags:
-        f.fail("tags", "an object needs at least one tag")
-    models = tuple(ModelBox(m.vec("position", 3), m.vec("size", 3, positive=True))
-                   for m in f.items("models"))
-    if not models:
-        f.fail("models", "an object needs at least one model box")
-    default = f.int("default_model")
-    if not 0 <= default < len(models):
-        f.fail("default_model", f"must index models (0..{len(models) - 1}), got {default}")
-    obj_type = f.str("type")
-    if obj_type != tags[0]:
-        f.fail("type", f"must equal the first tag {tags[0]!r}, got {obj_type!r}")
-    inherits = f.get("inherits_model_from")
-    return HouseObject(id=f.str("id"), type=obj_type, tags=tags, room=f.ref("room", rooms),
-                       prefab=f.str("prefab"), position=models[default].position, yaw=f.num("yaw"),
-                       size=models[default].size, size_estimated=f.bool("size_estimated"),
-                       models=models, default_model=default,
-                       inherits_model_from=None if inherits is None else f.str("inherits_model_from"))
-
-
-def _unique(root: _Fields, name: str, ids: list[str]) -> None:
+def _unique(source: str, name: str, ids: list[str]) -> set[str]:
     seen: set[str] = set()
     for i, x in enumerate(ids):
         if x in seen:
-            root.fail(f"{name}[{i}].id", f"duplicate id {x!r}")
+            raise FileFieldError(source, f"{name}[{i}].id", f"duplicate id {x!r}")
         seen.add(x)
+    return seen
 
 
-class _Fields:
-    """Typed access to one JSON object that reports bad fields as ``file: path.to.field: problem``."""
+class _References:
+    """Checks that room and object ids used across the file exist."""
 
-    def __init__(self, data: Any, source: str, path: str) -> None:
-        self.source, self.path = source, path
-        if not isinstance(data, dict):
-            raise FileFieldError(source, path or "(top level)", f"expected an object, got {_kind(data)}")
-        self.data = data
+    def __init__(self, source: str, rooms: set[str], objects: set[str]) -> None:
+        self.source, self.rooms, self.objects = source, rooms, objects
 
-    def fail(self, key: str, problem: str) -> None:
-        raise FileFieldError(self.source, self._at(key), problem)
+    def room(self, field_path: str, value: str) -> None:
+        if value not in self.rooms:
+            raise FileFieldError(self.source, field_path, f"unknown room id {shown(value)}")
 
-    def _at(self, key: str) -> str:
-        return f"{self.path}.{key}" if self.path else key
-
-    def get(self, key: str, default: Any = None) -> Any:
-        return self.data.get(key, default)
-
-    def _need(self, key: str) -> Any:
-        if key not in self.data:
-            self.fail(key, "missing")
-        return self.data[key]
-
-    def sub(self, key: str) -> _Fields:
-        return _Fields(self._need(key), self.source, self._at(key))
-
-    def list(self, key: str, default: list | None = None) -> list:
-        value = self.data.get(key, default) if default is not None else self._need(key)
-        if not isinstance(value, list):
-            self.fail(key, f"expected a list, got {_kind(value)}")
-        return value
-
-    def items(self, key: str) -> Iterator[_Fields]:
-        for i, v in enumerate(self.list(key)):
-            yield _Fields(v, self.source, self._at(f"{key}[{i}]"))
-
-    def str(self, key: str, value: Any = None) -> str:
-        value = self._need(key) if value is None else value
-        if not isinstance(value, str) or not value:
-            self.fail(key, f"expected a non-empty string, got {_kind(value)}")
-        return value
-
-    def bool(self, key: str) -> bool:
-        value = self._need(key)
-        if not isinstance(value, bool):
-            self.fail(key, f"expected true or false, got {_kind(value)}")
-        return value
-
-    def int(self, key: str) -> int:
-        value = self._need(key)
-        if not isinstance(value, int) or isinstance(value, bool):
-            self.fail(key, f"expected an integer, got {_kind(value)}")
-        return value
-
-    def num(self, key: str, value: Any = None) -> float:
-        value = self._need(key) if value is None else value
-        if not _is_number(value):
-            self.fail(key, f"expected a finite number, got {_kind(value)}")
-        return float(value)
-
-    def positive(self, key: str) -> float:
-        value = self.num(key)
-        if value <= 0:
-            self.fail(key, f"must be > 0, got {value}")
-        return value
-
-    def nonnegative(self, key: str) -> float:
-        value = self.num(key)
-        if value < 0:
-            self.fail(key, f"must be >= 0, got {value}")
-        return value
-
-    def choice(self, key: str, options: tuple[str, ...]) -> str:
-        value = self.str(key)
-        if value not in options:
-            self.fail(key, f"must be one of {', '.join(options)}, got {value!r}")
-        return value
-
-    def ref(self, key: str, valid: list[str], value: Any = None) -> str:
-        value = self.str(key, value)
-        if value not in valid:
-            self.fail(key, f"unknown id {value!r}")
-        return value
-
-    def vec(self, key: str, n: int, value: Any = None, positive: bool = False) -> tuple:
-        value = self._need(key) if value is None else value
-        if not (isinstance(value, list) and len(value) == n and all(_is_number(v) for v in value)):
-            self.fail(key, f"expected {n} finite numbers, got {_kind(value)}")
-        if positive and min(value) <= 0:
-            self.fail(key, f"every component must be > 0, got {value}")
-        return tuple(float(v) for v in value)
-
-    def polygon(self, key: str, value: Any = None) -> Polygon:
-        value = self._need(key) if value is None else value
-        if not isinstance(value, list) or len(value) < 3:
-            self.fail(key, f"expected a polygon of at least 3 points, got {_kind(value)}")
-        return tuple(self.vec(f"{key}[{i}]", 2, p) for i, p in enumerate(value))
-
-
-def _is_number(v: Any) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-
-
-def _kind(v: Any) -> str:
-    text = json.dumps(v) if not isinstance(v, float) or math.isfinite(v) else str(v)
-    return text if len(text) <= 40 else text[:37] + "..."
+    def object(self, field_path: str, value: str) -> None:
+        if value not in self.objects:
+            raise FileFieldError(self.source, field_path, f"unknown object id {shown(value)}")

@@ -13,12 +13,15 @@ import math
 import random
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import yaml
+from pydantic import AfterValidator, Field
 
+from ravh_msgs_py.appearance import SEED_MAX
 from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
 from ravh_sim.paths import DEFAULT_CONFIG, ROBOTS_DIR
+from ravh_sim.schema import Strict, read_text, shown, validate
 from ravh_sim.world import paints
 from ravh_sim.world.furniture import variant_count
 from ravh_sim.world.house import House
@@ -26,6 +29,106 @@ from ravh_sim.world.house import House
 SUN_PRESETS = {"day": 100.0, "sunset": 180.0, "night": 200.0}
 SWITCH = ("on", "off", "random")
 DOOR_STATES = ("default", "open", "closed", "random")
+AGENT_CLEARANCE = 0.5      # m between two agents' start positions (two Giraff radii)
+
+
+# --------------------------------------------------------------------------- the file's schema
+# Values that mix words and numbers get one validator each, so an error says what is allowed.
+
+def _check_sun(v: Any) -> Any:
+    if v in (*SUN_PRESETS, "random") or isinstance(v, (int, float)) and not isinstance(v, bool) \
+            and math.isfinite(v) and 0 <= v <= 360:
+        return v
+    raise ValueError("expected degrees in [0, 360], day, sunset, night or random")
+
+
+def _check_switch(v: Any) -> Any:
+    if isinstance(v, bool) or v in SWITCH:  # YAML 1.1 reads on/off as booleans
+        return v
+    raise ValueError("expected on, off or random")
+
+
+def _check_door(v: Any) -> Any:
+    if isinstance(v, bool) or v in DOOR_STATES:
+        return v
+    raise ValueError(f"expected one of {', '.join(DOOR_STATES)}")
+
+
+def _check_paint(v: Any) -> Any:
+    if v in ("default", "random", "random_plain", "random_texture") or isinstance(v, str) and paints.is_paint(v):
+        return v
+    raise ValueError(f"unknown paint; use default, random, random_plain, random_texture, '#rrggbb' "
+                     f"or one of: {', '.join(paints.all_paints())}")
+
+
+def _check_model(v: Any) -> Any:
+    if v in ("default", "random") or isinstance(v, int) and not isinstance(v, bool) and v >= 0 or (
+            isinstance(v, dict) and set(v) == {"inherit"} and isinstance(v["inherit"], str)):
+        return v
+    raise ValueError("expected default, random, a model index >= 0 or {inherit: OBJECT_ID}")
+
+
+def _check_start(v: Any) -> Any:
+    if v == "station" or isinstance(v, list) and len(v) == 3 and all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v):
+        return v
+    raise ValueError("expected station or [x, y, yaw] (finite numbers)")
+
+
+def _checked(check) -> Any:
+    return Annotated[Any, AfterValidator(check)]
+
+
+class _Lights(Strict):
+    sun_angle: _checked(_check_sun)
+    ceiling: _checked(_check_switch)
+    lamps: _checked(_check_switch)
+    set: dict[str, _checked(_check_switch)]
+
+
+class _Doors(Strict):
+    all: _checked(_check_door)
+    set: dict[str, _checked(_check_door)]
+
+
+class _RoomPaint(Strict):
+    walls: _checked(_check_paint) = None
+    floor: _checked(_check_paint) = None
+
+
+class _Paint(Strict):
+    walls: _checked(_check_paint)
+    floors: _checked(_check_paint)
+    rooms: dict[str, _RoomPaint]
+
+
+class _Models(Strict):
+    all: _checked(_check_model)
+    set: dict[str, _checked(_check_model)]
+    inherit: bool
+
+
+class _Agent(Strict):
+    name: Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")] = None
+    profile: Annotated[str, Field(min_length=1, max_length=64)] = "giraff"
+    start: _checked(_check_start) = "station"
+
+
+class SettingsFile(Strict):
+    """Every key of a settings file after merging over the defaults (config/default.yaml)."""
+    seed: Annotated[int, Field(ge=0, le=SEED_MAX)]
+    lights: _Lights
+    doors: _Doors
+    paint: _Paint
+    models: _Models
+    agents: list[_Agent]
+
+
+def check_seed(seed: Any) -> int:
+    """A seed from a flag or a request, held to the settings file's rule."""
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= SEED_MAX:
+        raise UserError(f"seed: expected an integer in 0..{SEED_MAX}, got {shown(seed)}")
+    return seed
 
 
 @dataclass(frozen=True)
@@ -60,19 +163,21 @@ class Resolved:
 
 
 def load_settings(path: Path | str | None = None) -> dict[str, Any]:
-    """Read a settings YAML over the defaults; unknown keys are errors that name file and key."""
+    """Read a settings YAML over the defaults and validate every key; errors name file and key."""
     base = _read_yaml(DEFAULT_CONFIG)
     if path is None:
         return base
     user = _read_yaml(Path(path))
-    _check_keys(user, base, str(path), "")
-    return _merge(base, user)
+    merged = _merge(base, user)
+    validate(SettingsFile, merged, path)
+    return merged
 
 
 def resolve(settings: dict[str, Any], house: House, seed: int | None = None,
             source: str = "settings") -> Resolved:
     """Turn general settings into explicit per-item choices for ``house``."""
-    seed = int(settings.get("seed", 0) if seed is None else seed)
+    validate(SettingsFile, settings, source)
+    seed = settings["seed"] if seed is None else check_seed(seed)
     pick = _Picker(seed)
     lights_cfg, doors_cfg = settings["lights"], settings["doors"]
     paint_cfg, models_cfg = settings["paint"], settings["models"]
@@ -105,21 +210,11 @@ def _sun_angle(value: Any, pick: _Picker, source: str) -> float:
         return SUN_PRESETS[value]
     if value == "random":
         return pick.rng("sun", "angle").uniform(0.0, 240.0)
-    if isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) \
-            and 0 <= value <= 360:
-        return float(value)
-    raise FileFieldError(source, "lights.sun_angle",
-                         f"expected degrees in [0, 360], day, sunset, night or random; got {value!r}")
+    return float(_check_sun(value))
 
 
-def _switch(value: Any, source: str, field_path: str) -> str:
-    if value is True:                       # YAML 1.1 reads on/off as booleans
-        return "on"
-    if value is False:
-        return "off"
-    if value not in SWITCH:
-        raise FileFieldError(source, field_path, f"expected on, off or random; got {value!r}")
-    return value
+def _switch(value: Any) -> str:
+    return {True: "on", False: "off"}.get(value, value) if isinstance(value, bool) else value
 
 
 def _resolve_lights(cfg: dict, house: House, pick: _Picker, source: str) -> dict[str, bool]:
@@ -128,9 +223,9 @@ def _resolve_lights(cfg: dict, house: House, pick: _Picker, source: str) -> dict
     for light in house.lights:
         group = "ceiling" if light.kind == "ceiling" else "lamps"
         if light.id in per_light:
-            state = _switch(per_light[light.id], source, f"lights.set.{light.id}")
+            state = _switch(per_light[light.id])
         else:
-            state = _switch(cfg.get(group, "on"), source, f"lights.{group}")
+            state = _switch(cfg[group])
         out[light.id] = pick.coin("light", light.id) if state == "random" else state == "on"
     return out
 
@@ -139,12 +234,9 @@ def _resolve_doors(cfg: dict, house: House, pick: _Picker, source: str) -> dict[
     per_door = _per_item(cfg, "doors.set", house.door_by_id, "door", source)
     out = {}
     for door in house.doors:
-        key = f"doors.set.{door.id}" if door.id in per_door else "doors.all"
-        state = per_door.get(door.id, cfg.get("all", "default"))
-        if state is True or state is False:
+        state = per_door.get(door.id, cfg["all"])
+        if isinstance(state, bool):
             state = "open" if state else "closed"
-        if state not in DOOR_STATES:
-            raise FileFieldError(source, key, f"expected one of {', '.join(DOOR_STATES)}; got {state!r}")
         out[door.id] = {"default": door.default_open, "open": True, "closed": False,
                         "random": pick.coin("door", door.id)}[state]
     return out
@@ -156,18 +248,13 @@ def _resolve_paint(cfg: dict, house: House, pick: _Picker, source: str) -> dict[
     for room in house.rooms:
         surfaces = {}
         for surface, general in (("walls", "walls"), ("floor", "floors")):
-            room_cfg = per_room.get(room.id) or {}
-            if not isinstance(room_cfg, dict):
-                raise FileFieldError(source, f"paint.rooms.{room.id}", "expected {walls: ..., floor: ...}")
-            key = f"paint.rooms.{room.id}.{surface}" if surface in room_cfg else f"paint.{general}"
-            value = room_cfg.get(surface, cfg.get(general, "default"))
-            surfaces[surface] = _paint(value, room.type, surface, pick.rng("paint", f"{room.id}/{surface}"),
-                                       source, key)
+            value = (per_room.get(room.id) or {}).get(surface) or cfg[general]
+            surfaces[surface] = _paint(value, room.type, surface, pick.rng("paint", f"{room.id}/{surface}"))
         out[room.id] = surfaces
     return out
 
 
-def _paint(value: Any, room_type: str, surface: str, rng: random.Random, source: str, key: str) -> str:
+def _paint(value: str, room_type: str, surface: str, rng: random.Random) -> str:
     if value == "default":
         return paints.default_paint(room_type, surface)
     if value == "random":
@@ -176,35 +263,31 @@ def _paint(value: Any, room_type: str, surface: str, rng: random.Random, source:
         return rng.choice(list(paints.PLAIN_COLOURS))
     if value == "random_texture":
         return rng.choice(paints.TEXTURES)
-    if isinstance(value, str) and paints.is_paint(value):
-        return value
-    raise FileFieldError(source, key, f"unknown paint {value!r}; use default, random, random_plain, "
-                         f"random_texture, '#rrggbb' or one of: {', '.join(paints.all_paints())}")
+    return value
 
 
 def _resolve_models(cfg: dict, house: House, pick: _Picker, source: str) -> dict[str, int]:
     per_object = _per_item(cfg, "models.set", house.object_by_id, "object", source)
+    if isinstance(cfg["all"], int) and house.objects:
+        _index(cfg["all"], max(variant_count(o.type) for o in house.objects), source, "models.all")
     explicit: dict[str, int] = {}
     inherit_from: dict[str, str] = {}
     for obj in house.objects:
         key = f"models.set.{obj.id}" if obj.id in per_object else "models.all"
-        value = per_object.get(obj.id, cfg.get("all", "default"))
+        value = per_object.get(obj.id, cfg["all"])
         count = variant_count(obj.type)
         if isinstance(value, dict) and set(value) == {"inherit"}:
             inherit_from[obj.id] = str(house.object(value["inherit"]).id)
             continue
-        if obj.id not in per_object and cfg.get("inherit", True) and obj.inherits_model_from:
+        if obj.id not in per_object and cfg["inherit"] and obj.inherits_model_from:
             inherit_from[obj.id] = obj.inherits_model_from
             continue
         if value == "default":
             explicit[obj.id] = obj.default_model
         elif value == "random":
             explicit[obj.id] = pick.rng("model", obj.id).randrange(count)
-        elif isinstance(value, int) and not isinstance(value, bool):
+        else:   # an index: per object it must exist; models.all wraps for objects with fewer models
             explicit[obj.id] = value % count if obj.id not in per_object else _index(value, count, source, key)
-        else:
-            raise FileFieldError(source, key, f"expected default, random, a model index or "
-                                 f"{{inherit: OBJECT_ID}}; got {value!r}")
     return {obj.id: _follow(obj.id, explicit, inherit_from) for obj in house.objects}
 
 
@@ -223,41 +306,40 @@ def _follow(obj_id: str, explicit: dict[str, int], inherit_from: dict[str, str])
     return explicit.get(obj_id, 0)
 
 
-def _resolve_agents(cfg: Any, house: House, source: str) -> list[AgentSpec]:
-    if not isinstance(cfg, list):
-        raise FileFieldError(source, "agents", "expected a list of agents")
+def _resolve_agents(cfg: list[dict], house: House, source: str) -> list[AgentSpec]:
     agents, names = [], set()
     for i, a in enumerate(cfg):
-        if not isinstance(a, dict):
-            raise FileFieldError(source, f"agents[{i}]", "expected {name, profile, start}")
-        name = str(a.get("name", f"robot{i}"))
+        name = a.get("name") or f"robot{i}"
         if name in names:
             raise FileFieldError(source, f"agents[{i}].name", f"duplicate agent name {name!r}")
         names.add(name)
-        profile = str(a.get("profile", "giraff"))
+        profile = a.get("profile", "giraff")
         if not (ROBOTS_DIR / f"{profile}.yaml").exists():
             valid = sorted(p.stem for p in ROBOTS_DIR.glob("*.yaml"))
             raise FileFieldError(source, f"agents[{i}].profile", str(UnknownNameError("robot profile",
                                                                                       profile, valid)))
-        agents.append(AgentSpec(name, profile, _start_pose(a.get("start", "station"), house, source,
-                                                           f"agents[{i}].start")))
+        pose = _start_pose(a.get("start", "station"), house, source, f"agents[{i}].start")
+        for other in agents:
+            if math.dist(pose[:2], other.pose[:2]) < AGENT_CLEARANCE:
+                raise FileFieldError(source, f"agents[{i}].start", f"within {AGENT_CLEARANCE} m of agent "
+                                     f"{other.name!r}'s start; give each agent its own start")
+        agents.append(AgentSpec(name, profile, pose))
     return agents
 
 
 def _start_pose(value: Any, house: House, source: str, key: str) -> tuple[float, float, float]:
     if value == "station":
         return (house.station.position[0], house.station.position[1], house.station.yaw)
-    if isinstance(value, list) and len(value) == 3 and all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value):
-        return (float(value[0]), float(value[1]), float(value[2]))
-    raise FileFieldError(source, key, f"expected station or [x, y, yaw]; got {value!r}")
+    x, y, yaw = (float(v) for v in value)
+    try:
+        house.room_at_or_raise(x, y)
+    except UserError as e:
+        raise FileFieldError(source, key, str(e)) from None
+    return (x, y, yaw)
 
 
 def _per_item(cfg: dict, key: str, known: dict, kind: str, source: str) -> dict:
-    section = key.split(".")[1]
-    items = cfg.get(section) or {}
-    if not isinstance(items, dict):
-        raise FileFieldError(source, key, f"expected a mapping of {kind} id to value")
+    items = cfg[key.split(".")[1]]
     for item in items:
         if item not in known:
             raise FileFieldError(source, f"{key}.{item}", str(UnknownNameError(kind, item, list(known))))
@@ -265,10 +347,11 @@ def _per_item(cfg: dict, key: str, known: dict, kind: str, source: str) -> dict:
 
 
 def _read_yaml(path: Path) -> dict[str, Any]:
+    text = read_text(path, "settings")
     try:
-        data = yaml.safe_load(path.read_text())
-    except OSError as e:
-        raise UserError(f"{path}: cannot read settings: {e.strerror}") from None
+        data = yaml.safe_load(text)
+    except RecursionError:
+        raise FileFieldError(path, "(top level)", "nested too deeply") from None
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f"line {mark.line + 1} column {mark.column + 1}" if mark else "-"
@@ -278,16 +361,6 @@ def _read_yaml(path: Path) -> dict[str, Any]:
     if not isinstance(data, dict):
         raise FileFieldError(path, "(top level)", "expected a mapping of settings")
     return data
-
-
-def _check_keys(user: dict, base: dict, source: str, prefix: str) -> None:
-    """Reject keys the defaults do not have (typos), except inside per-item maps."""
-    for key, value in user.items():
-        where = f"{prefix}{key}"
-        if key not in base:
-            raise FileFieldError(source, where, f"unknown key; valid: {', '.join(map(str, base))}")
-        if isinstance(value, dict) and isinstance(base[key], dict) and key not in ("set", "rooms"):
-            _check_keys(value, base[key], source, where + ".")
 
 
 def _merge(base: dict, user: dict) -> dict:

@@ -1,0 +1,42 @@
+"""Writing output files so that nothing half-written is ever left behind.
+
+Every file goes to a temporary name in its own folder, is fsynced and renamed into place: a reader,
+a full disk or a Ctrl-C at any instant leaves the old file or the new one, never a torn one. Images
+are encoded in memory first, so a failed encoding writes nothing at all.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+TMP_PREFIX = "."                       # temporary files are hidden: ".<name>.<pid>.tmp"
+
+
+def atomic_write(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` all at once: temp file in the same folder, fsync, rename.
+
+    The fsync before the rename keeps the name from ever pointing at unwritten blocks after a
+    power loss; os.replace is atomic on POSIX, so readers see the old file or the new one; a failed
+    write removes its temp file.
+    """
+    tmp = path.with_name(f"{TMP_PREFIX}{path.name}.{os.getpid()}.tmp")
+    try:
+        with open(tmp, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:                 # full disk, Ctrl-C: no half-written file stays behind
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def write_image(path: Path, image: np.ndarray) -> None:
+    """An image file in the format of ``path``'s suffix (cv2 channel order), written atomically."""
+    ok, data = cv2.imencode(path.suffix, image)
+    if not ok:
+        raise OSError(f"cannot encode an image as {path.suffix!r}", str(path))
+    atomic_write(path, data.tobytes())

@@ -1,0 +1,87 @@
+"""One way to validate every data file (settings, robot profiles, houses): pydantic models.
+
+Each file kind declares its fields, types and bounds as a pydantic model (strict: ``1.5`` is not an
+integer, ``true`` is not a number, unknown keys are errors). :func:`validate` turns pydantic's report
+into the project's one-line :class:`FileFieldError` naming the file and the field path of the first
+problem; :func:`read_text` reads a file so that unreadable or non-UTF-8 files fail the same way.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Any, TypeVar
+
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
+
+from ravh_sim.errors import FileFieldError, UserError
+
+M = TypeVar("M", bound=BaseModel)
+SHOWN_INPUT = 40          # characters of a bad value quoted in an error (never echo a huge input)
+
+
+class Strict(BaseModel):
+    """Base of every file schema: no type coercion, no unknown keys, immutable."""
+    model_config = ConfigDict(strict=True, extra="forbid", frozen=True)
+
+
+def _finite(v: float) -> float:
+    if not math.isfinite(v):
+        raise ValueError(f"expected a finite number, got {v}")
+    return v
+
+
+def number(ge: float | None = None, le: float | None = None, gt: float | None = None,
+           lt: float | None = None) -> Any:
+    """A finite float field with bounds; strict floats take ints (YAML/JSON write 1 for 1.0), not bools."""
+    return Annotated[float, Field(ge=ge, le=le, gt=gt, lt=lt), AfterValidator(_finite)]
+
+
+def vector(item: Any, n: int) -> Any:
+    """A fixed-length tuple field that files write as a list."""
+    return Annotated[tuple[(item,) * n], Field(strict=False)]
+
+
+def validate(model: type[M], data: Any, source: str | Path) -> M:
+    """``model`` from ``data``, or a one-line FileFieldError naming ``source`` and the first bad field."""
+    try:
+        return model.model_validate(data)
+    except ValidationError as e:
+        first = e.errors(include_url=False)[0]
+        raise FileFieldError(str(source), field_path(first["loc"]), _problem(first)) from None
+    except RecursionError:
+        raise FileFieldError(str(source), "(top level)", "nested too deeply") from None
+
+
+def field_path(loc: tuple) -> str:
+    """('agents', 0, 'start') -> 'agents[0].start'."""
+    out = ""
+    for part in loc:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out or "(top level)"
+
+
+def _problem(error: dict) -> str:
+    msg = error["msg"].removeprefix("Value error, ")
+    if error["type"] == "missing":
+        return "missing"
+    if error["type"] == "extra_forbidden":
+        return "unknown key"
+    if error["type"] in ("model_type", "dict_type"):
+        return f"expected a mapping, got {shown(error.get('input'))}"
+    return f"{msg}, got {shown(error.get('input'))}"
+
+
+def shown(value: Any) -> str:
+    """A short quote of a value for an error message."""
+    text = repr(value)
+    return text if len(text) <= SHOWN_INPUT else text[:SHOWN_INPUT - 3] + "..."
+
+
+def read_text(path: Path, what: str) -> str:
+    """The UTF-8 text of ``path``; unreadable or undecodable files raise a one-line UserError."""
+    try:
+        return path.read_text(encoding="utf-8")
+    except OSError as e:
+        raise UserError(f"{path}: cannot read {what}: {e.strerror}") from None
+    except UnicodeDecodeError as e:
+        raise FileFieldError(str(path), f"byte {e.start}", f"not UTF-8 text ({what})") from None
