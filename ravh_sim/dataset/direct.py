@@ -35,6 +35,7 @@ from ravh_msgs_py import names
 from ravh_sim.behaviours.grid import GridSweep
 from ravh_sim.behaviours.wanderer import Wanderer
 from ravh_sim.behaviours.waypoints import ORDERS, Layout, grid_nodes, light_waypoints
+from ravh_sim.dataset import layout
 from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nav.follower import CONTROL_PERIOD, PathFollower
@@ -42,7 +43,6 @@ from ravh_sim.runtime import Agent, Rates, SimRuntime
 
 Pose2D = tuple[float, float, float]
 SETTINGS_FILE = "raid_settings.yaml"
-SUMMARY_FILE = "raid.json"
 MAX_SIM_S = 3600.0               # sim seconds after which a behaviour that never ends is stopped
 WRITES_IN_FLIGHT = 4             # captures encoded and written behind the renderer at most
 
@@ -118,7 +118,7 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
     summary = {**meta, "status": status, "captures": len(rows),
                "rooms_visited": sorted({r for r in rows if r}),
                "wall_s": round(time.monotonic() - start, 1), "sim_s": round(session.sim_span, 1)}
-    (out / SUMMARY_FILE).write_text(json.dumps(summary, indent=1))
+    layout.atomic_write(out / layout.RAID_JSON, (json.dumps(summary, indent=1) + "\n").encode())
     return summary
 
 
@@ -165,7 +165,7 @@ class _Session:
         end = self.runtime.time + max_sim_s
         while not behaviour.done:
             if self.runtime.time >= end:
-                return f"stopped at {max_sim_s:.0f} sim s"
+                return f"timed out after {max_sim_s:.0f} sim s"
             for _ in behaviour.update(dt):
                 self.capture()
                 if max_captures and len(self.rows) >= max_captures:
