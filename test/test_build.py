@@ -46,11 +46,11 @@ def test_house_and_raid_lists():
 def test_build_is_interrupted_and_resumed_without_redoing_finished_raids(tmp_path):
     out = tmp_path / "ds"
     args = ("dataset", "build", "--houses", "20,29", "--raids", "0,1", "--workers", "2", "--out", str(out), *SMALL)
-    first = _ravh(*args)
+    first = _ravh(*args, start_new_session=True)
     deadline = time.monotonic() + 300
     while not list(out.glob("house*/raid*/raid.json")) and first.poll() is None and time.monotonic() < deadline:
         time.sleep(0.2)
-    first.send_signal(signal.SIGINT)                       # as Ctrl-C in a terminal
+    os.killpg(first.pid, signal.SIGINT)                    # Ctrl-C: the build and its workers
     first.communicate(timeout=120)
     finished = {p.parent: (p.stat().st_mtime_ns, (p.parent / "captures.jsonl").stat().st_mtime_ns)
                 for p in out.glob("house*/raid*/raid.json")}

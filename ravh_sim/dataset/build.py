@@ -202,15 +202,20 @@ def _run_on_ray(todo: list[Job], root: Path, options: BuildOptions, _workers: in
     try:
         task = ray.remote(num_cpus=1, max_retries=RAY_RETRIES, retry_exceptions=True)(_run_job_on_ray)
         running = {task.remote(job, root, options): job for job in todo}
-        while running:
-            ready, _ = ray.wait(list(running), num_returns=1, timeout=POLL_S)
-            for ref in ready:
-                job = running.pop(ref)
-                try:
-                    on_result(job, ray.get(ref), None)
-                except ray.exceptions.RayError as e:
-                    on_result(job, None, _describe(e))
-            poll()
+        try:
+            while running:
+                ready, _ = ray.wait(list(running), num_returns=1, timeout=POLL_S)
+                for ref in ready:
+                    job = running.pop(ref)
+                    try:
+                        on_result(job, ray.get(ref), None)
+                    except ray.exceptions.RayError as e:
+                        on_result(job, None, _describe(e))
+                poll()
+        except BaseException:
+            for ref in running:                  # no task left writing into OUT after we stop
+                ray.cancel(ref, force=True)
+            raise
     finally:
         ray.shutdown()
 
@@ -300,7 +305,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--raids", default="0-4", help="paper presets 0-4 (default all): 0 grid/day, 1 wanderer/day, "
                    "2 random paint+models, 3 sunset, 4 night")
     p.add_argument("--out", type=Path, required=True, help="dataset folder (shared by the nodes with --ray)")
-    p.add_argument("--workers", type=int, default=1, help="raids at once on this machine (default 1)")
+    p.add_argument("--workers", type=int, default=1,
+                   help="raids at once on this machine (default 1; with --ray, Ray gives each raid a CPU)")
     p.add_argument("--engine", choices=ENGINES, default="direct",
                    help="direct: one process, no DDS (default); ros: sim, behaviour and recorder nodes")
     p.add_argument("--seed", type=int, default=None,

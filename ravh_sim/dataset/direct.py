@@ -6,7 +6,7 @@ recorder processes), stepped in lockstep: the behaviour is updated every control
 time, each capture it asks for is rendered and written at once, and physics steps as fast as the
 machine allows. Nothing here depends on wall time or thread timing, so the same house, settings
 and seed give byte-identical capture files and captures.jsonl (only dataset.json's ``created``
-and raid.json's ``wall_s`` say when and how fast it ran).
+and raid.json's ``wall_s`` and ``cpu_s`` say when and how fast it ran).
 
 The API other code calls::
 
@@ -82,7 +82,7 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
            max_sim_s: float = MAX_SIM_S, raid: dict[str, Any] | None = None, renderer: str = "auto",
            progress: Callable[[int], None] | None = None) -> dict[str, Any]:
     """Record one raid of ``house`` into the new folder ``out``; return its summary (also written
-    to ``out/raid.json``, the same keys as the ROS engine's).
+    to ``out/raid.json``: the ROS engine's keys, and ``cpu_s``, the CPU seconds this process used).
 
     behaviour: a spec, or "grid" / "wanderer" for the paper's parameters. settings: settings-file
     overrides (None: config/default.yaml). seed: every random choice (None: the settings' seed).
@@ -98,7 +98,7 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
     out.mkdir(parents=True, exist_ok=True)
     settings_path = out / SETTINGS_FILE
     settings_path.write_text(yaml.safe_dump(settings or {}, sort_keys=False))
-    start = time.monotonic()
+    start, cpu_start = time.monotonic(), time.process_time()
     runtime = SimRuntime(house, settings_path, seed, renderer=renderer, rates=Rates(0.0, 0.0, 0.0, 0.0))
     try:
         meta = {"house": runtime.house.number, "engine": "direct", "behaviour": _describe(spec),
@@ -117,7 +117,8 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
         runtime.close()
     summary = {**meta, "status": status, "captures": len(rows),
                "rooms_visited": sorted({r for r in rows if r}),
-               "wall_s": round(time.monotonic() - start, 1), "sim_s": round(session.sim_span, 1)}
+               "wall_s": round(time.monotonic() - start, 1), "cpu_s": round(time.process_time() - cpu_start, 1),
+               "sim_s": round(session.sim_span, 1)}
     layout.atomic_write(out / layout.RAID_JSON, (json.dumps(summary, indent=1) + "\n").encode())
     return summary
 
