@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import os
+import secrets
 import shutil
 import signal
 import subprocess
@@ -99,7 +100,9 @@ class RayCluster:
         self.temp = Path(tempfile.mkdtemp(prefix="ravh_ray_"))      # short: Ray's socket paths
         self.port = 20000 + os.getpid() % 20000
         self.address = f"127.0.0.1:{self.port}"
-        self.env = subprocess_env(RAY_USAGE_STATS_ENABLED="0", RAY_GRACEFUL_SHUTDOWN_DRAIN_TIMEOUT_S="0")
+        # a token of its own: the ports are open only to this test's processes (and ~/.ray is not read)
+        self.env = subprocess_env(RAY_USAGE_STATS_ENABLED="0", RAY_GRACEFUL_SHUTDOWN_DRAIN_TIMEOUT_S="0",
+                                  RAY_AUTH_MODE="token", RAY_AUTH_TOKEN=secrets.token_hex(32))
         self.logs = tmp
         self.procs: list[subprocess.Popen] = []
 
@@ -143,17 +146,28 @@ class RayCluster:
 
 
 def test_ray_cluster_of_two_nodes_builds_two_raids(tmp_path):
+    """The build as Ray tasks on a head and a worker node (the driver in its own process, as the CLI
+    runs it): one raid per node, and the same files as a build on the local pool."""
     cluster = RayCluster(tmp_path)
+    out = tmp_path / "shared"
+    driver = ("import json, sys; from pathlib import Path; from ravh_sim.dataset.build import build; "
+              "print(json.dumps(build(Path(sys.argv[1]), [20], [0, 1], ray_address=sys.argv[2], max_nodes=1, "
+              "max_captures=12, show_progress=False)))")
     try:
         cluster.start()
-        out = tmp_path / "shared"
-        result = build(out, [20], [0, 1], ray_address=cluster.address, max_nodes=1, max_captures=12,
-                       show_progress=False)
+        run = subprocess.run([sys.executable, "-c", driver, str(out), cluster.address], cwd=ROOT,
+                             env=cluster.env, capture_output=True, text=True, timeout=600)
     finally:
         cluster.stop()
+    assert run.returncode == 0, run.stderr[-3000:]
+    result = json.loads(run.stdout.strip().splitlines()[-1])
     assert not result["failed"], result["failed"]
     assert [(r["house"], r["raid"]) for r in result["raids"]] == [(20, 0), (20, 1)]
     assert len({r["ray_node"] for r in result["raids"]}) == 2           # one raid on each node
+    local = tmp_path / "local"
+    build(local, [20], [0], max_nodes=1, max_captures=12, show_progress=False)
     for raid in (0, 1):
         ds = _complete(out / "house20" / f"raid{raid}")
         assert len(ds) == json.loads((out / "house20" / f"raid{raid}" / "raid.json").read_text())["captures"]
+    for path in (local / "house20" / "raid0").rglob("*.png"):
+        assert path.read_bytes() == (out / path.relative_to(local)).read_bytes(), path

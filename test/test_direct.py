@@ -76,9 +76,11 @@ def test_bad_requests_are_clear_errors(tmp_path):
         record(tmp_path / "x", 20, "dance")
     with pytest.raises(UserError, match="order"):
         record(tmp_path / "y", 20, WandererSpec(order="sideways"))
-    record(tmp_path / "z", 20, PosesSpec(((-3.0, 1.6, 0.0),)))
+    record(tmp_path / "z", 20, PosesSpec(((-3.0, 1.6, 0.0),)), settings={"seed": 4})
+    kept = {name: (tmp_path / "z" / name).read_bytes() for name in ("raid_settings.yaml", "captures.jsonl")}
     with pytest.raises(UserError, match="already holds"):
-        record(tmp_path / "z", 20, PosesSpec(((-3.0, 1.6, 0.0),)))
+        record(tmp_path / "z", 20, PosesSpec(((-3.0, 1.6, 0.0),)), settings={"seed": 5})
+    assert kept == {name: (tmp_path / "z" / name).read_bytes() for name in kept}      # nothing lost
 
 
 # ---------------------------------------------------------------------------- against the ROS engine

@@ -200,7 +200,11 @@ def _run_on_ray(todo: list[Job], root: Path, options: BuildOptions, _workers: in
         return
     ray.init(address=address, logging_level="warning", log_to_driver=False)
     try:
-        task = ray.remote(num_cpus=1, max_retries=RAY_RETRIES, retry_exceptions=True)(_run_job_on_ray)
+        # max_calls=1: a fresh worker process per raid, as on the local pool (pybullet and EGL state
+        # of one raid never meets the next; in a process that started Ray, only its first World
+        # renders bit-exactly the images a fresh process does)
+        task = ray.remote(num_cpus=1, max_retries=RAY_RETRIES, retry_exceptions=True,
+                          max_calls=1)(_run_job_on_ray)
         running = {task.remote(job, root, options): job for job in todo}
         try:
             while running:

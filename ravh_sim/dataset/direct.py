@@ -26,7 +26,7 @@ from collections import deque
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any, Callable
 
 import numpy as np
 import yaml
@@ -95,15 +95,14 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
     if isinstance(spec, WandererSpec) and spec.order not in ORDERS:
         raise UserError(f"wanderer order must be one of {', '.join(ORDERS)}, got {spec.order!r}")
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    settings_path = out / SETTINGS_FILE
-    settings_path.write_text(yaml.safe_dump(settings or {}, sort_keys=False))
     start, cpu_start = time.monotonic(), time.process_time()
-    runtime = SimRuntime(house, settings_path, seed, renderer=renderer, rates=Rates(0.0, 0.0, 0.0, 0.0))
-    try:
-        meta = {"house": runtime.house.number, "engine": "direct", "behaviour": _describe(spec),
-                "seed": runtime.world.settings.seed, **(raid or {})}
-        with DatasetWriter(out) as writer:
+    with DatasetWriter(out) as writer:         # refuses a folder with a dataset before writing anything
+        settings_path = out / SETTINGS_FILE
+        settings_path.write_text(yaml.safe_dump(settings or {}, sort_keys=False))
+        runtime = SimRuntime(house, settings_path, seed, renderer=renderer, rates=Rates(0.0, 0.0, 0.0, 0.0))
+        try:
+            meta = {"house": runtime.house.number, "engine": "direct", "behaviour": _describe(spec),
+                    "seed": runtime.world.settings.seed, **(raid or {})}
             session = _Session(runtime, writer, progress)
             writer.write_meta(runtime.house.number, [session.agent.name], meta)
             writer.write_footprint(runtime.footprint())
@@ -112,9 +111,9 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
                 status = session.run(spec, max_captures, max_sim_s)
             finally:
                 session.finish_writes()
-        rows = session.rows
-    finally:
-        runtime.close()
+        finally:
+            runtime.close()
+    rows = session.rows
     summary = {**meta, "status": status, "captures": len(rows),
                "rooms_visited": sorted({r for r in rows if r}),
                "wall_s": round(time.monotonic() - start, 1), "cpu_s": round(time.process_time() - cpu_start, 1),
@@ -198,9 +197,10 @@ class _Session:
                   "frame_id": names.agent_name(names.CAMERA_OPTICAL_FRAME, agent.name, agent.first)}
         if len(self._writes) >= WRITES_IN_FLIGHT:
             self._writes.popleft().result()          # re-raises a failed write here
+        # copies: the writer thread must own its pixels (a sensor may reuse its buffers next frame)
         self._writes.append(self._worker.submit(
             self.writer.write_capture, rt.time, agent.name, (x, y, yaw), agent.robot.odometry, room,
-            cap.rgb, cap.depth, cap.instance.astype(np.uint16), scan.ranges,
+            cap.rgb.copy(), cap.depth.copy(), cap.instance.astype(np.uint16), scan.ranges.copy(),
             {"angle_min": float32(scan.angle_min), "angle_increment": float32(scan.angle_increment),
              "range_min": float32(scan.range_min), "range_max": float32(scan.range_max)}, camera))
         self.rows.append(room)
