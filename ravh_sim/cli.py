@@ -287,6 +287,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("dataset", type=Path, help="dataset folder written by the recorder")
     p.add_argument("-o", "--output", type=Path, required=True, help="PNG file")
     p.set_defaults(func=cmd_raid_summary)
+
+    from ravh_sim.eval.commands import register as register_eval
+    register_eval(sub)
     return parser
 
 
