@@ -27,6 +27,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print JSON instead of the text table")
     p.set_defaults(func=cmd_eval_semantic_map)
 
+    p = which.add_parser("localization", help="appearance-based localization errors, routes x maps (Table 4)")
+    p.add_argument("--house", type=int, default=15, help="house number (default 15)")
+    p.add_argument("--out", type=Path, required=True,
+                   help="folder for the recordings (reused when present), table4.json/.txt/.png")
+    p.add_argument("--quick", action="store_true", help="CI-sized: 2 short routes, 2 maps of the grid nodes along them")
+    p.add_argument("--descriptor", default=None,
+                   help="'module:function' (RGB image -> vector); default: the gradient_grid baseline")
+    p.add_argument("--seed", type=int, default=0, help="seed of the recordings and the odometry noise")
+    p.set_defaults(func=cmd_eval_localization)
+
 
 def cmd_semantic_map(args: argparse.Namespace) -> int:
     from ravh_sim.dataset.api import Dataset
@@ -52,4 +62,17 @@ def cmd_eval_semantic_map(args: argparse.Namespace) -> int:
         (args.out / "table3.json").write_text(json.dumps(doc, indent=1) + "\n")
         (args.out / "table3.txt").write_text(text + "\n")
     print(json.dumps(doc, indent=1) if args.json else text)
+    return 0
+
+
+def cmd_eval_localization(args: argparse.Namespace) -> int:
+    import sys
+
+    from ravh_sim.eval.table4 import FULL, QUICK, format_table4, run_table4
+    from ravh_sim.world.house import load_house
+    load_house(args.house)                            # unknown house: the usual clear error
+    doc = run_table4(args.house, args.out, QUICK if args.quick else FULL, args.descriptor, args.seed,
+                     progress=lambda text: print(text, file=sys.stderr, flush=True))
+    print(format_table4(doc))
+    print(f"wrote {args.out / 'table4.json'} and {args.out / 'table4.png'}")
     return 0
