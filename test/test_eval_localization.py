@@ -56,3 +56,15 @@ def test_odometry_carries_the_route_through_uninformative_images():
 def test_errors_wrap_headings():
     position, rotation = errors(np.array([[0.0, 0.0, math.pi - 0.01]]), np.array([[3.0, 4.0, -math.pi + 0.01]]))
     assert position[0] == pytest.approx(5.0) and rotation[0] == pytest.approx(math.degrees(0.02))
+
+
+def test_motion_update_on_near_pairs_equals_the_full_one():
+    poses, descriptors = _map()
+    sparse = Localizer(descriptors, poses)
+    dense = Localizer(descriptors, poses)
+    dense._from, dense._to = (a.ravel() for a in np.indices((len(poses), len(poses))))
+    belief = np.random.default_rng(4).random(len(poses))
+    belief /= belief.sum()
+    step = np.array([0.3, -0.1, 0.4])
+    assert np.allclose(sparse._move(belief, step), dense._move(belief, step), rtol=1e-3, atol=0)   # 3 sigma cut
+    assert len(sparse._from) < len(dense._from) / 2

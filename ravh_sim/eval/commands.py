@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 
@@ -66,8 +67,6 @@ def cmd_eval_semantic_map(args: argparse.Namespace) -> int:
 
 
 def cmd_eval_localization(args: argparse.Namespace) -> int:
-    import sys
-
     from ravh_sim.eval.table4 import FULL, QUICK, format_table4, run_table4
     from ravh_sim.world.house import load_house
     load_house(args.house)                            # unknown house: the usual clear error

@@ -16,7 +16,7 @@ kernel, so no single strong edge dominates).
 from __future__ import annotations
 
 import importlib
-from typing import Callable
+from typing import Callable, Iterable
 
 import cv2
 import numpy as np
@@ -69,7 +69,7 @@ def load_descriptor(spec: str | None) -> tuple[str, Descriptor]:
     return spec, function
 
 
-def describe(images, descriptor: Descriptor) -> np.ndarray:
+def describe(images: Iterable[np.ndarray], descriptor: Descriptor) -> np.ndarray:
     """(N, D) float32 L2-normalised descriptors of an iterable of RGB images."""
     rows = []
     for image in images:

@@ -29,6 +29,8 @@ TEMPERATURE = 0.02
 SPREAD_M = 0.25
 SPREAD_DEG = 25.0
 FLOOR = 1e-3
+REACH = 3.0                           # kernel widths beyond which belief is not moved
+MAX_STEP_M, MAX_TURN_DEG = 0.5, 45.0  # odometry steps up to these use the precomputed pairs
 ESTIMATE_RADIUS_M = 0.75
 ODOMETRY_SIGMA = (0.06, 1.0)          # m, deg
 
@@ -48,6 +50,15 @@ class Localizer:
     descriptors: np.ndarray
     poses: np.ndarray
 
+    def __post_init__(self) -> None:
+        """The (from, to) pairs of map images a step of at most MAX_STEP_M / MAX_TURN_DEG can move
+        belief between (beyond REACH kernel widths the kernel is negligible): the motion update
+        then costs the pairs, not N squared."""
+        x, y, yaw = self.poses.T
+        near = np.hypot(x[:, None] - x[None], y[:, None] - y[None]) <= REACH * SPREAD_M + MAX_STEP_M
+        near &= np.abs(_wrap(yaw[None] - yaw[:, None])) <= math.radians(REACH * SPREAD_DEG + MAX_TURN_DEG)
+        self._from, self._to = np.nonzero(near)
+
     def localize(self, route_descriptors: np.ndarray, odometry: np.ndarray) -> np.ndarray:
         """(T, 3) pose estimates for the route (see the module for the method)."""
         similarity = route_descriptors @ self.descriptors.T
@@ -62,14 +73,19 @@ class Localizer:
         return estimates
 
     def _move(self, belief: np.ndarray, step: np.ndarray) -> np.ndarray:
+        """The belief after an odometry step: each image's share spread over the images near its
+        pose moved by the step."""
         x, y, yaw = self.poses.T
         c, s = np.cos(yaw), np.sin(yaw)
         moved = np.column_stack((x + c * step[0] - s * step[1], y + s * step[0] + c * step[1], yaw + step[2]))
-        d2 = ((moved[:, None, 0] - x[None]) ** 2 + (moved[:, None, 1] - y[None]) ** 2) / SPREAD_M ** 2
-        turn = (moved[:, None, 2] - yaw[None] + np.pi) % (2 * np.pi) - np.pi
-        kernel = np.exp(-0.5 * (d2 + (turn / math.radians(SPREAD_DEG)) ** 2))
-        kernel /= kernel.sum(axis=1, keepdims=True)
-        out = belief @ kernel
+        if math.hypot(step[0], step[1]) <= MAX_STEP_M and abs(_wrap(step[2])) <= math.radians(MAX_TURN_DEG):
+            i, j = self._from, self._to
+        else:                                                  # an unusually long step: every pair
+            i, j = (a.ravel() for a in np.indices((len(x), len(x))))
+        d2 = ((moved[i, 0] - x[j]) ** 2 + (moved[i, 1] - y[j]) ** 2) / SPREAD_M ** 2
+        kernel = np.exp(-0.5 * (d2 + (_wrap(moved[i, 2] - yaw[j]) / math.radians(SPREAD_DEG)) ** 2))
+        row = np.bincount(i, weights=kernel, minlength=len(x))
+        out = np.bincount(j, weights=kernel * (belief / np.maximum(row, 1e-300))[i], minlength=len(x))
         return (1.0 - FLOOR) * out / out.sum() + FLOOR / len(out)
 
     def _estimate(self, belief: np.ndarray) -> tuple[float, float, float]:
@@ -80,8 +96,12 @@ class Localizer:
         return (float(w @ x), float(w @ y), math.atan2(float(w @ np.sin(yaw)), float(w @ np.cos(yaw))))
 
 
+def _wrap(a: np.ndarray) -> np.ndarray:
+    return (a + np.pi) % (2 * np.pi) - np.pi
+
+
 def errors(estimates: np.ndarray, truth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per step: position error (m) and absolute heading error (deg)."""
     position = np.hypot(estimates[:, 0] - truth[:, 0], estimates[:, 1] - truth[:, 1])
-    rotation = np.degrees(np.abs((estimates[:, 2] - truth[:, 2] + np.pi) % (2 * np.pi) - np.pi))
+    rotation = np.degrees(np.abs(_wrap(estimates[:, 2] - truth[:, 2])))
     return position, rotation

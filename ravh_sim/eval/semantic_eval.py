@@ -30,7 +30,7 @@ import numpy as np
 
 from ravh_sim.dataset.api import MIN_PIXELS, Dataset
 from ravh_sim.errors import UserError
-from ravh_sim.eval.semantic_map import LabelledBox, SemanticMap, intersection_volume
+from ravh_sim.eval.semantic_map import LabelledBox, SemanticMap, intersection_volume, read_map
 from ravh_sim.viz.plan import render_plan, write_plan
 
 DEFAULT_THRESHOLD = 0.5
@@ -216,7 +216,6 @@ def draw_result(dataset: Dataset, semantic_map: SemanticMap, result: HouseResult
 def evaluate_datasets(pairs: Sequence[tuple[Path, Path]], threshold: float = DEFAULT_THRESHOLD,
                       picture_dir: Path | None = None) -> dict[str, Any]:
     """Evaluate each (dataset folder, map file) pair; Table 3 as JSON, pictures if asked."""
-    from ravh_sim.eval.semantic_map import read_map
     results = []
     for dataset_dir, map_path in pairs:
         dataset = Dataset(dataset_dir)

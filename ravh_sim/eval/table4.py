@@ -2,10 +2,11 @@
 
 Maps are Grid raids (nodes every 0.5 m, 10 images per node) under the map lightings; routes are
 Wanderer raids (about :attr:`Protocol.route_m` metres, an image every :attr:`Protocol.capture_period`
-s) under the route lightings. The CI-sized protocol (:data:`QUICK`) keeps two maps and two short
-routes, and its maps hold only the grid nodes along the route, captured in place. Lighting is the sun angle l_a (degrees: 90 noon, 180 sunset, > 180
+s) under the route lightings. Lighting is the sun angle l_a (degrees: 90 noon, 180 sunset, > 180
 night) with the rest of config/default.yaml (ceiling lights on, lamps off, default paint and
-models), so only the light differs between a route and a map. Every recording is an ordinary
+models), so only the light differs between a route and a map. The CI-sized protocol
+(:data:`QUICK`) keeps two maps and two short routes; its maps hold only the grid nodes along the
+first route, captured in place. Every recording is an ordinary
 dataset under ``OUT/maps/`` and ``OUT/routes/``; a later run reuses recordings made with the same
 protocol and seed. Each route is localized against each map (:mod:`ravh_sim.eval.localization`)
 :data:`RUNS` times with different odometry noise; a cell of the table is the median over the runs
@@ -23,8 +24,8 @@ from typing import Any, Callable
 import cv2
 import numpy as np
 
-from ravh_sim.dataset.api import Dataset
 from ravh_sim.behaviours.waypoints import Layout, grid_nodes
+from ravh_sim.dataset.api import Dataset
 from ravh_sim.dataset.direct import SUMMARY_FILE, GridSpec, PosesSpec, WandererSpec, record
 from ravh_sim.errors import UserError
 from ravh_sim.eval.descriptors import Descriptor, describe, load_descriptor
@@ -62,8 +63,8 @@ class Protocol:
     grid_nodes: int = 0            # 0: the whole house
     route_m: float = 25.0
     capture_period: float = 1.0    # s between route images
-    map_near_route_m: float = 0.0  # > 0: the map is only the grid nodes this close to the first route,
-                                   # captured in place (scripted poses, no driving): the CI-sized map
+    map_near_route_m: float = 0.0  # > 0: the map is only the grid nodes this close to the first
+                                   # route, captured in place (scripted poses): the CI-sized map
 
 
 FULL = Protocol()
@@ -79,15 +80,15 @@ def run_table4(house: int, out: Path, protocol: Protocol = FULL, descriptor: str
         name, function = load_descriptor(descriptor)
     say = progress or (lambda _: None)
     started = time.monotonic()
-    route_spec = WandererSpec("once", protocol.capture_period, seed)
-    routes = {r: _recording(out / "routes" / r.folder, house, r, route_spec, protocol.route_m / SPEED, seed, say)
+    route_spec, route_s = WandererSpec("once", protocol.capture_period, seed), protocol.route_m / SPEED
+    routes = {r: _recording(out / "routes" / r.folder, house, r, route_spec, route_s, seed, say)
               for r in protocol.routes}
     map_spec = _map_spec(protocol, routes[protocol.routes[0]])
     maps = {m: _recording(out / "maps" / m.folder, house, m, map_spec, 0.0, seed, say) for m in protocol.maps}
     recorded = time.monotonic()
     say("describing images")
-    map_side = {m: (describe((s.rgb for s in ds), function), np.array([s.pose for s in ds])) for m, ds in maps.items()}
-    route_side = {r: (describe((s.rgb for s in ds), function), np.array([s.pose for s in ds])) for r, ds in routes.items()}
+    map_side = {m: _described(ds, function) for m, ds in maps.items()}
+    route_side = {r: _described(ds, function) for r, ds in routes.items()}
     cells = []
     for r, (route_desc, truth) in route_side.items():
         row = []
@@ -147,6 +148,11 @@ def _recording(folder: Path, house: int, light: Lighting, behaviour: GridSpec | 
     if not summary["captures"]:
         raise UserError(f"{folder}: the {behaviour.name} recorded no images ({summary['status']})")
     return Dataset(folder)
+
+
+def _described(dataset: Dataset, descriptor: Descriptor) -> tuple[np.ndarray, np.ndarray]:
+    """(descriptors, poses) of a dataset's captures."""
+    return describe((s.rgb for s in dataset), descriptor), np.array([s.pose for s in dataset])
 
 
 def _length(poses: np.ndarray) -> float:
