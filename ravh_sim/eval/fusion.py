@@ -12,7 +12,8 @@ This is the API for plugging in a detector (Detectron2 or anything that gives in
     semantic_map = build_map(Dataset("raid20"), detect)
 
 Each detection's mask pixels with depth are back-projected through the capture's camera (intrinsics
-from camera.json, mount from the robot profile, ground-truth pose) into house-frame points. Rules,
+and distortion from camera.json, mount from the robot profile, ground-truth pose) into house-frame
+points. Rules,
 the same for every mapper:
 
 * masks of at least :data:`ERODE_FROM` pixels are eroded by one pixel first, so edge pixels that
@@ -64,8 +65,9 @@ class CameraModel:
         self.dataset = dataset
         profiles = {a.name: a.profile for a in dataset.settings.agents}
         self._spec = {agent: load_profile(profiles.get(agent, "giraff")).camera for agent in dataset.meta["agents"]}
-        self._K_inv = {agent: np.linalg.inv(np.array(cam["K"], float).reshape(3, 3))
-                       for agent, cam in dataset.camera.items()}
+        self._K = {agent: np.array(cam["K"], float).reshape(3, 3) for agent, cam in dataset.camera.items()}
+        self._D = {agent: np.array(cam.get("D") or [], float) for agent, cam in dataset.camera.items()}
+        self._outside_floor_z = float(np.median([r.floor_z for r in dataset.house.rooms]))   # as World's
 
     def points(self, sample: Sample, mask: np.ndarray, at_most: int = 0) -> np.ndarray:
         """(N, 3) house-frame points of the ``mask`` pixels that have depth (``at_most``: a
@@ -77,7 +79,11 @@ class CameraModel:
         z = sample.depth[v, u]
         keep = np.isfinite(z)
         u, v, z = u[keep], v[keep], z[keep]
-        rays = np.column_stack((u, v, np.ones_like(u))).astype(float) @ self._K_inv[sample.agent].T
+        if len(u) == 0:
+            return np.zeros((0, 3))
+        rays = np.ones((len(u), 3))
+        pixels = np.column_stack((u, v)).astype(np.float64).reshape(-1, 1, 2)
+        rays[:, :2] = cv2.undistortPoints(pixels, self._K[sample.agent], self._D[sample.agent]).reshape(-1, 2)
         position, rotation = self.optical_pose(sample)
         return (rays * z[:, None].astype(float)) @ rotation.T + position
 
@@ -85,7 +91,7 @@ class CameraModel:
         spec = self._spec[sample.agent]
         x, y, yaw = sample.pose
         room = self.dataset.house.room_at(x, y)
-        floor_z = room.floor_z if room is not None else 0.0
+        floor_z = room.floor_z if room is not None else self._outside_floor_z
         return (mount_position(x, y, yaw, floor_z, spec.height, spec.forward),
                 mount_rotation(yaw, math.radians(spec.pitch_deg)) @ LINK_TO_OPTICAL)
 
