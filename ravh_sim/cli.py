@@ -317,6 +317,8 @@ def _parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_raid_summary)
 
     add_dataset_parser(sub)
+    from ravh_sim.eval.commands import register as register_eval
+    register_eval(sub)
     return parser
 
 

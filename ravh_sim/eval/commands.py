@@ -1,0 +1,77 @@
+"""``ravh semantic-map`` and ``ravh eval ...``: parsers and thin shells over the eval modules."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the evaluation commands to ``ravh``'s subcommands."""
+    p = sub.add_parser("semantic-map", help="build a semantic map (JSON boxes) of a dataset with a reference mapper")
+    p.add_argument("--dataset", type=Path, required=True, help="dataset folder")
+    p.add_argument("--mapper", choices=("oracle", "degraded"), default="oracle",
+                   help="oracle: true masks; degraded: with seeded detector errors (default oracle)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the degraded mapper's errors")
+    p.add_argument("-o", "--output", type=Path, required=True, help="semantic-map JSON file")
+    p.set_defaults(func=cmd_semantic_map)
+
+    evaluation = sub.add_parser("eval", help="the paper's benchmarks: semantic maps (Table 3), localization (Table 4)")
+    which = evaluation.add_subparsers(metavar="BENCHMARK")
+    p = which.add_parser("semantic-map", help="precision/recall of semantic maps against the ground truth")
+    p.add_argument("--dataset", type=Path, nargs="+", required=True, help="dataset folders (one per house)")
+    p.add_argument("--map", type=Path, nargs="+", required=True, help="semantic-map files, one per dataset")
+    p.add_argument("--iou", type=float, default=None,
+                   help="overlap threshold (intersection / smaller volume; default 0.5)")
+    p.add_argument("--out", type=Path, default=None, help="folder for table3.json/.txt and the plan pictures")
+    p.add_argument("--json", action="store_true", help="print JSON instead of the text table")
+    p.set_defaults(func=cmd_eval_semantic_map)
+
+    p = which.add_parser("localization", help="appearance-based localization errors, routes x maps (Table 4)")
+    p.add_argument("--house", type=int, default=15, help="house number (default 15)")
+    p.add_argument("--out", type=Path, required=True,
+                   help="folder for the recordings (reused when present), table4.json/.txt/.png")
+    p.add_argument("--quick", action="store_true", help="CI-sized: 2 short routes, 2 maps of the grid nodes along them")
+    p.add_argument("--descriptor", default=None,
+                   help="'module:function' (RGB image -> vector); default: the gradient_grid baseline")
+    p.add_argument("--seed", type=int, default=0, help="seed of the recordings and the odometry noise")
+    p.set_defaults(func=cmd_eval_localization)
+
+
+def cmd_semantic_map(args: argparse.Namespace) -> int:
+    from ravh_sim.dataset.api import Dataset
+    from ravh_sim.eval.mappers import run_mapper
+    from ravh_sim.eval.semantic_map import write_map
+    semantic_map = run_mapper(Dataset(args.dataset), args.mapper, args.seed)
+    write_map(semantic_map, args.output)
+    print(f"wrote {args.output} ({len(semantic_map.boxes)} boxes)")
+    return 0
+
+
+def cmd_eval_semantic_map(args: argparse.Namespace) -> int:
+    from ravh_sim.errors import UserError
+    from ravh_sim.eval.semantic_eval import DEFAULT_THRESHOLD, evaluate_datasets, format_table
+    if len(args.dataset) != len(args.map):
+        raise UserError(f"give one --map per --dataset ({len(args.dataset)} datasets, {len(args.map)} maps)")
+    threshold = DEFAULT_THRESHOLD if args.iou is None else args.iou
+    if not 0.0 < threshold <= 1.0:
+        raise UserError(f"--iou must be in (0, 1], got {threshold}")
+    doc = evaluate_datasets(list(zip(args.dataset, args.map)), threshold, args.out)
+    text = format_table(doc)
+    if args.out is not None:
+        (args.out / "table3.json").write_text(json.dumps(doc, indent=1) + "\n")
+        (args.out / "table3.txt").write_text(text + "\n")
+    print(json.dumps(doc, indent=1) if args.json else text)
+    return 0
+
+
+def cmd_eval_localization(args: argparse.Namespace) -> int:
+    from ravh_sim.eval.table4 import FULL, QUICK, format_table4, run_table4
+    from ravh_sim.world.house import load_house
+    load_house(args.house)                            # unknown house: the usual clear error
+    doc = run_table4(args.house, args.out, QUICK if args.quick else FULL, args.descriptor, args.seed,
+                     progress=lambda text: print(text, file=sys.stderr, flush=True))
+    print(format_table4(doc))
+    print(f"wrote {args.out / 'table4.json'} and {args.out / 'table4.png'}")
+    return 0

@@ -1,0 +1,218 @@
+"""The paper's localization benchmark (§5.5, Table 4) on one house: record, localize, tabulate.
+
+Maps are Grid raids (nodes every 0.5 m, 10 images per node) under the map lightings; routes are
+Wanderer raids (about :attr:`Protocol.route_m` metres, an image every :attr:`Protocol.capture_period`
+s) under the route lightings. Lighting is the sun angle l_a (degrees: 90 noon, 180 sunset, > 180
+night) with the rest of config/default.yaml (ceiling lights on, lamps off, default paint and
+models), so only the light differs between a route and a map. The CI-sized protocol
+(:data:`QUICK`) keeps two maps and two short routes; its maps hold only the grid nodes along the
+first route, captured in place. Every recording is an ordinary
+dataset under ``OUT/maps/`` and ``OUT/routes/``; a later run reuses recordings made with the same
+protocol and seed. Each route is localized against each map (:mod:`ravh_sim.eval.localization`)
+:data:`RUNS` times with different odometry noise; a cell of the table is the median over the runs
+of each run's median position error (m) and rotation error (deg).
+"""
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+import cv2
+import numpy as np
+
+from ravh_sim.behaviours.waypoints import Layout, grid_nodes
+from ravh_sim.dataset.api import Dataset
+from ravh_sim.dataset.direct import SUMMARY_FILE, GridSpec, PosesSpec, WandererSpec, record
+from ravh_sim.errors import UserError
+from ravh_sim.eval.descriptors import Descriptor, describe, load_descriptor
+from ravh_sim.eval.localization import Localizer, errors, noisy_odometry
+
+RUNS = 5
+SPEED = 0.25                       # m/s, the Wanderer's cruise speed (the giraff profile's maximum)
+
+
+@dataclass(frozen=True)
+class Lighting:
+    name: str                      # day | sunset | night
+    sun_angle: float               # l_a, degrees
+
+    @property
+    def label(self) -> str:
+        return f"{self.name} {self.sun_angle:g}"
+
+    @property
+    def folder(self) -> str:
+        return f"{self.name}_{self.sun_angle:g}"
+
+
+MAPS = (Lighting("day", 170), Lighting("sunset", 179), Lighting("night", 200))
+ROUTES = (Lighting("day", 90), Lighting("sunset", 175), Lighting("night", 185), Lighting("night", 195),
+          Lighting("day", 25), Lighting("day", 165))
+
+
+@dataclass(frozen=True)
+class Protocol:
+    maps: tuple[Lighting, ...] = MAPS
+    routes: tuple[Lighting, ...] = ROUTES
+    grid_spacing: float = 0.5
+    images_per_node: int = 10
+    grid_nodes: int = 0            # 0: the whole house
+    route_m: float = 25.0
+    capture_period: float = 1.0    # s between route images
+    map_near_route_m: float = 0.0  # > 0: the map is only the grid nodes this close to the first
+                                   # route, captured in place (scripted poses): the CI-sized map
+
+
+FULL = Protocol()
+QUICK = Protocol(maps=MAPS[::2], routes=(ROUTES[0], ROUTES[2]), route_m=8.0, map_near_route_m=0.5)
+
+
+def run_table4(house: int, out: Path, protocol: Protocol = FULL, descriptor: str | Descriptor | None = None,
+               seed: int = 0, progress: Callable[[str], None] | None = None) -> dict[str, Any]:
+    """Record what is missing, localize every route on every map, write table4.json/.txt/.png."""
+    if callable(descriptor):
+        name, function = getattr(descriptor, "__name__", "custom"), descriptor
+    else:
+        name, function = load_descriptor(descriptor)
+    say = progress or (lambda _: None)
+    started = time.monotonic()
+    route_spec, route_s = WandererSpec("once", protocol.capture_period, seed), protocol.route_m / SPEED
+    routes = {r: _recording(out / "routes" / r.folder, house, r, route_spec, route_s, seed, say)
+              for r in protocol.routes}
+    map_spec = _map_spec(protocol, routes[protocol.routes[0]])
+    maps = {m: _recording(out / "maps" / m.folder, house, m, map_spec, 0.0, seed, say) for m in protocol.maps}
+    recorded = time.monotonic()
+    say("describing images")
+    map_side = {m: _described(ds, function) for m, ds in maps.items()}
+    route_side = {r: _described(ds, function) for r, ds in routes.items()}
+    cells = []
+    for r, (route_desc, truth) in route_side.items():
+        row = []
+        for m, (map_desc, map_poses) in map_side.items():
+            localizer = Localizer(map_desc, map_poses)
+            runs = []
+            for run in range(RUNS):
+                odometry = noisy_odometry(truth, np.random.default_rng([seed, run]))
+                position, rotation = errors(localizer.localize(route_desc, odometry), truth)
+                runs.append((float(np.median(position)), float(np.median(rotation))))
+            row.append({"route": r.label, "map": m.label,
+                        "position_m": round(float(np.median([p for p, _ in runs])), 3),
+                        "rotation_deg": round(float(np.median([a for _, a in runs])), 2),
+                        "runs": [{"position_m": round(p, 3), "rotation_deg": round(a, 2)} for p, a in runs]})
+        cells.append(row)
+    doc = {"house": house, "descriptor": name, "seed": seed, "runs": RUNS,
+           "protocol": _protocol_doc(protocol),
+           "maps": {m.label: {"images": len(maps[m]), "dataset": str(maps[m].dir)} for m in protocol.maps},
+           "routes": {r.label: {"images": len(routes[r]), "length_m": round(_length(route_side[r][1]), 2),
+                                "dataset": str(routes[r].dir)} for r in protocol.routes},
+           "cells": cells,
+           "wall_s": {"record": round(recorded - started, 1), "evaluate": round(time.monotonic() - recorded, 1)}}
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "table4.json").write_text(json.dumps(doc, indent=1) + "\n")
+    (out / "table4.txt").write_text(format_table4(doc) + "\n")
+    cv2.imwrite(str(out / "table4.png"), draw_table4(doc))
+    return doc
+
+
+def _map_spec(protocol: Protocol, route: Dataset) -> GridSpec | PosesSpec:
+    """The Grid behaviour, or (CI-sized) its nodes near ``route`` captured in place, the same
+    number of headings per node."""
+    if protocol.map_near_route_m <= 0:
+        return GridSpec(protocol.grid_spacing, protocol.images_per_node, protocol.grid_nodes)
+    route_xy = np.array([s.pose[:2] for s in route])
+    nodes = grid_nodes(Layout.of(route.house), route.map, tuple(route_xy[0]), protocol.grid_spacing)
+    near = [n for n in nodes if np.hypot(*(route_xy - n).T).min() <= protocol.map_near_route_m]
+    k = protocol.images_per_node
+    return PosesSpec(tuple((x, y, 2 * math.pi * i / k) for x, y in near for i in range(k)))
+
+
+def _recording(folder: Path, house: int, light: Lighting, behaviour: GridSpec | WandererSpec | PosesSpec,
+               max_sim_s: float, seed: int, say: Callable[[str], None]) -> Dataset:
+    """The dataset of one map or route: reused if recorded before with the same request."""
+    limits = {"max_sim_s": max_sim_s} if max_sim_s > 0 else {}
+    request = json.loads(json.dumps({"benchmark": "table4", "house": house, "sun_angle": light.sun_angle,
+                                     "seed": seed, "behaviour": behaviour.name, "spec": asdict(behaviour),
+                                     **limits}))
+    summary_path = folder / SUMMARY_FILE
+    if summary_path.exists():
+        if json.loads(summary_path.read_text()).get("request") == request:
+            return Dataset(folder)
+        raise UserError(f"{folder} holds a recording of other settings; use another --out or remove it")
+    say(f"recording {behaviour.name} {light.label} into {folder}")
+    summary = record(folder, house, behaviour, settings={"lights": {"sun_angle": light.sun_angle}}, seed=seed,
+                     raid={"request": request}, **limits)
+    if not summary["captures"]:
+        raise UserError(f"{folder}: the {behaviour.name} recorded no images ({summary['status']})")
+    return Dataset(folder)
+
+
+def _described(dataset: Dataset, descriptor: Descriptor) -> tuple[np.ndarray, np.ndarray]:
+    """(descriptors, poses) of a dataset's captures."""
+    return describe((s.rgb for s in dataset), descriptor), np.array([s.pose for s in dataset])
+
+
+def _length(poses: np.ndarray) -> float:
+    return float(np.hypot(*np.diff(poses[:, :2], axis=0).T).sum()) if len(poses) > 1 else 0.0
+
+
+def _protocol_doc(protocol: Protocol) -> dict[str, Any]:
+    doc = asdict(protocol)
+    doc["maps"] = [m.label for m in protocol.maps]
+    doc["routes"] = [r.label for r in protocol.routes]
+    return doc
+
+
+def format_table4(doc: dict[str, Any]) -> str:
+    """Routes x maps: median position error (m) / rotation error (deg)."""
+    maps = list(doc["maps"])
+    lines = [f"House {doc['house']}, descriptor {doc['descriptor']}: median position (m) / rotation (deg) "
+             f"error, median of {doc['runs']} runs",
+             f"{'route / map':<14}" + "".join(f"{m:>18}" for m in maps)]
+    for row in doc["cells"]:
+        lines.append(f"{row[0]['route']:<14}" + "".join(f"{c['position_m']:>10.2f} / {c['rotation_deg']:>5.1f}"
+                                                        for c in row))
+    return "\n".join(lines)
+
+
+# --------------------------------------------------------------------------- the heat map
+
+CELL_W, CELL_H, LABEL_W, HEAD_H, GAP = 120, 44, 120, 70, 40
+FONT = cv2.FONT_HERSHEY_SIMPLEX
+
+
+def draw_table4(doc: dict[str, Any]) -> np.ndarray:
+    """Two heat maps side by side, position and rotation error, routes x maps (BGR)."""
+    panels = [_panel(doc, "position_m", "position error (m)", "{:.2f}"),
+              _panel(doc, "rotation_deg", "rotation error (deg)", "{:.1f}")]
+    height = max(p.shape[0] for p in panels)
+    title = np.full((40, sum(p.shape[1] for p in panels) + GAP, 3), 255, np.uint8)
+    cv2.putText(title, f"House {doc['house']} localization ({doc['descriptor']}), median of {doc['runs']} runs",
+                (12, 28), FONT, 0.65, (40, 40, 40), 1, cv2.LINE_AA)
+    body = np.hstack([panels[0], np.full((height, GAP, 3), 255, np.uint8), panels[1]])
+    return np.vstack([title, body])
+
+
+def _panel(doc: dict[str, Any], key: str, heading: str, fmt: str) -> np.ndarray:
+    rows, maps = doc["cells"], list(doc["maps"])
+    values = np.array([[c[key] for c in row] for row in rows], float)
+    img = np.full((HEAD_H + CELL_H * len(rows) + 10, LABEL_W + CELL_W * len(maps) + 10, 3), 255, np.uint8)
+    cv2.putText(img, heading, (LABEL_W, 22), FONT, 0.6, (40, 40, 40), 1, cv2.LINE_AA)
+    top = values.max() if values.size and values.max() > 0 else 1.0
+    colours = cv2.applyColorMap(np.uint8(np.clip(values / top, 0, 1) * 255).reshape(-1, 1), cv2.COLORMAP_VIRIDIS)
+    for j, m in enumerate(maps):
+        cv2.putText(img, f"map {m}", (LABEL_W + j * CELL_W + 6, HEAD_H - 12), FONT, 0.45, (40, 40, 40), 1,
+                    cv2.LINE_AA)
+    for i, row in enumerate(rows):
+        y = HEAD_H + i * CELL_H
+        cv2.putText(img, row[0]["route"], (6, y + CELL_H // 2 + 5), FONT, 0.5, (40, 40, 40), 1, cv2.LINE_AA)
+        for j in range(len(maps)):
+            x = LABEL_W + j * CELL_W
+            colour = tuple(int(c) for c in colours[i * len(maps) + j, 0])
+            cv2.rectangle(img, (x, y), (x + CELL_W - 2, y + CELL_H - 2), colour, -1)
+            ink = (0, 0, 0) if values[i, j] / top > 0.6 else (255, 255, 255)
+            cv2.putText(img, fmt.format(values[i, j]), (x + 30, y + CELL_H // 2 + 6), FONT, 0.55, ink, 1, cv2.LINE_AA)
+    return img

@@ -1,0 +1,61 @@
+"""``ravh eval localization --quick`` end to end on house 20: recordings, table, picture, reuse."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from ravh_sim.cli import main
+from ravh_sim.dataset.api import Dataset
+from ravh_sim.errors import UserError
+from ravh_sim.eval.descriptors import describe, gradient_grid
+from ravh_sim.eval.localization import Localizer, errors, noisy_odometry
+from ravh_sim.eval.table4 import QUICK, RUNS, run_table4
+
+
+@pytest.fixture(scope="module")
+def quick_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("table4") / "h20"
+    assert main(["eval", "localization", "--house", "20", "--out", str(out), "--quick"]) == 0
+    return out
+
+
+def test_quick_table(quick_run):
+    doc = json.loads((quick_run / "table4.json").read_text())
+    assert [[c["route"] for c in row] for row in doc["cells"]] == [[r.label] * len(QUICK.maps) for r in QUICK.routes]
+    assert [c["map"] for c in doc["cells"][0]] == [m.label for m in QUICK.maps]
+    for row in doc["cells"]:
+        for cell in row:
+            assert len(cell["runs"]) == RUNS
+            run_medians = [r["position_m"] for r in cell["runs"]]
+            assert cell["position_m"] == pytest.approx(float(np.median(run_medians)), abs=1e-3)
+            assert 0.0 <= cell["position_m"] < 1.5 and 0.0 <= cell["rotation_deg"] < 60.0
+    for route in doc["routes"].values():
+        assert route["images"] >= 10 and route["length_m"] > 2.0
+    assert (quick_run / "table4.png").stat().st_size > 5_000 and (quick_run / "table4.txt").exists()
+
+
+def test_route_equal_to_a_map_trajectory_has_near_zero_error(quick_run):
+    """The map's own images, in recording order, as a route under the same light."""
+    dataset = Dataset(quick_run / "maps" / QUICK.maps[0].folder)
+    descriptors = describe((s.rgb for s in dataset), gradient_grid)
+    poses = np.array([s.pose for s in dataset])
+    estimates = Localizer(descriptors, poses).localize(descriptors, noisy_odometry(poses, np.random.default_rng(0)))
+    position, rotation = errors(estimates, poses)
+    assert np.median(position) < 0.02 and np.median(rotation) < 1.0
+
+
+def test_recordings_are_reused_and_descriptors_plug_in(quick_run, capsys):
+    constant = run_table4(20, quick_run, QUICK, lambda image: np.ones(4), progress=print)
+    assert "recording" not in capsys.readouterr().out
+    assert constant["descriptor"] == "<lambda>"
+    informed = run_table4(20, quick_run, QUICK)
+    blind_error = np.mean([c["position_m"] for row in constant["cells"] for c in row])
+    seen_error = np.mean([c["position_m"] for row in informed["cells"] for c in row])
+    assert seen_error < blind_error
+
+
+def test_a_folder_of_other_recordings_is_refused(quick_run):
+    with pytest.raises(UserError, match="other settings"):
+        run_table4(20, quick_run, QUICK, seed=1)
