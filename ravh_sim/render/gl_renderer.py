@@ -8,7 +8,8 @@ expensive light transport is computed when the scene changes, not per frame: the
 through the window openings), one cube shadow map per switched-on lamp (walls confine its light;
 open doors let it through) and a top-down coverage map that gives floors their ambient occlusion.
 Per frame: the pass, the procedural sky behind the windows, mipmaps for auto-exposure and a tone
-map (ACES, sRGB). ``fast`` quality skips shadow look-ups and confines lamps to their room instead.
+map (ACES, sRGB). ``fast`` quality draws every surface with the plain material in one pass, skips
+shadow look-ups and reflections, and confines lamps to their room instead.
 
 Light units are arbitrary but consistent (exposure adapts): the sun gives SUN_IRRADIANCE on a
 surface facing it at noon, a lamp of intensity 1 gives LAMP_POWER / d^2.
@@ -34,7 +35,7 @@ from ravh_sim.world.topology import room_index_raster, room_links
 
 KINDS = {"floor": 0, "ceiling": 1, "walls": 2, "object": 3, "door": 4, "window": 5}
 MAX_LIGHTS = 32                       # switched-on lights with a shadow map
-FRAME_LIGHTS = 6                      # lights shading one frame (the nearest)
+FRAME_LIGHTS = 4                      # lights shading one frame (the nearest)
 FRAME_LIGHT_REACH = 9.0               # m: lights farther from the camera are left out of a frame
 SUN_SHADOW_TEXELS = 2048
 LAMP_TILE = 192                       # texels per cube face of a lamp's shadow map
@@ -217,6 +218,8 @@ class GLRenderer:
         counts = np.bincount(triangle_pattern, minlength=len(PATTERN))
         starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
         self._ranges = [(k, 3 * int(starts[k]), 3 * int(counts[k])) for k in range(len(PATTERN)) if counts[k]]
+        if not self.shadows:                      # fast: every surface in one plain-material draw
+            self._ranges = [(PATTERN["plain"], 0, len(vertices))]
         positions = vertices[:, :3]
         self._bounds = (positions.min(axis=0), positions.max(axis=0))
         if self.vbo is not None:
