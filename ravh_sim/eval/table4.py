@@ -61,7 +61,8 @@ class Protocol:
     grid_spacing: float = 0.5
     images_per_node: int = 10
     grid_nodes: int = 0            # 0: the whole house
-    route_m: float = 25.0
+    route_m: float = 25.0          # the Wanderer stops after route_m / SPEED s of sim time; its turns
+                                   # make the route shorter (house 15: 20.8 m)
     capture_period: float = 1.0    # s between route images
     map_near_route_m: float = 0.0  # > 0: the map is only the grid nodes this close to the first
                                    # route, captured in place (scripted poses): the CI-sized map
