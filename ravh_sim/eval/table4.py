@@ -190,17 +190,22 @@ def draw_table4(doc: dict[str, Any]) -> np.ndarray:
     panels = [_panel(doc, "position_m", "position error (m)", "{:.2f}"),
               _panel(doc, "rotation_deg", "rotation error (deg)", "{:.1f}")]
     height = max(p.shape[0] for p in panels)
-    title = np.full((40, sum(p.shape[1] for p in panels) + GAP, 3), 255, np.uint8)
-    cv2.putText(title, f"House {doc['house']} localization ({doc['descriptor']}), median of {doc['runs']} runs",
-                (12, 28), FONT, 0.65, (40, 40, 40), 1, cv2.LINE_AA)
+    panels = [np.vstack([p, np.full((height - p.shape[0], p.shape[1], 3), 255, np.uint8)]) for p in panels]
     body = np.hstack([panels[0], np.full((height, GAP, 3), 255, np.uint8), panels[1]])
-    return np.vstack([title, body])
+    text = (f"House {doc['house']} localization ({doc['descriptor']}), median of {doc['runs']} runs; "
+            "colour from 0 (dark) to the largest value (yellow)")
+    width = max(body.shape[1], cv2.getTextSize(text, FONT, 0.55, 1)[0][0] + 24)
+    title = np.full((40, width, 3), 255, np.uint8)
+    cv2.putText(title, text, (12, 28), FONT, 0.55, (40, 40, 40), 1, cv2.LINE_AA)
+    return np.vstack([title, np.hstack([body, np.full((height, width - body.shape[1], 3), 255, np.uint8)])])
 
 
 def _panel(doc: dict[str, Any], key: str, heading: str, fmt: str) -> np.ndarray:
     rows, maps = doc["cells"], list(doc["maps"])
     values = np.array([[c[key] for c in row] for row in rows], float)
-    img = np.full((HEAD_H + CELL_H * len(rows) + 10, LABEL_W + CELL_W * len(maps) + 10, 3), 255, np.uint8)
+    heading_w = cv2.getTextSize(heading, FONT, 0.6, 1)[0][0]
+    width = LABEL_W + max(CELL_W * len(maps), heading_w) + 10
+    img = np.full((HEAD_H + CELL_H * len(rows) + 10, width, 3), 255, np.uint8)
     cv2.putText(img, heading, (LABEL_W, 22), FONT, 0.6, (40, 40, 40), 1, cv2.LINE_AA)
     top = values.max() if values.size and values.max() > 0 else 1.0
     colours = cv2.applyColorMap(np.uint8(np.clip(values / top, 0, 1) * 255).reshape(-1, 1), cv2.COLORMAP_VIRIDIS)
