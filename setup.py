@@ -30,7 +30,8 @@ setup(
         *tree("houses"),
         *tree("config"),
     ],
-    install_requires=["numpy", "pybullet", "opencv-python-headless", "pyyaml", "trimesh", "rosbags"],
+    install_requires=["numpy", "pybullet", "opencv-python-headless", "pyyaml", "trimesh", "rosbags", "tqdm"],
+    extras_require={"ray": ["ray"]},          # ravh dataset build --ray: raids as tasks on a Ray cluster
     zip_safe=True,
     maintainer="ravh_sim developers",
     description="Robot@VirtualHome for ROS 2: realistic virtual houses in pybullet",

@@ -29,7 +29,7 @@ def run(what: str, houses: list[int] | None = None) -> dict[str, Any]:
     benches: dict[str, Callable[..., dict[str, Any]]] = {"load": bench_load, "nav": bench_nav,
                                                           "sensors": bench_sensors,
                                                           "node": bench_ros.bench_node,
-                                                          "raid": bench_ros.bench_raid}
+                                                          "raid": bench_raid}
     return benches[what](houses=houses)
 
 
@@ -275,3 +275,80 @@ def _lighting_times(camera, appearance, poses) -> list[float]:
                                                               frame.rotation, frame.position, sun, lights))
             times.append(seconds * 1000)
     return times
+
+
+RAID_HOUSE = 20
+RAID_RATIO_TARGET = 4.0
+DATASET_HOURS_TARGET = 2.0
+
+
+def bench_raid(houses: list[int] | None = None) -> dict[str, Any]:
+    """Raid speed, direct engine against the ROS engine, and what the whole dataset would take.
+
+    * House 20, raid 1 (wanderer, day): captures per wall second and per CPU second (all threads
+      and processes of the engine: the measure that holds on a loaded machine) with the direct
+      engine (one process) and the ROS engine (``ravh raid --fast``: three processes over DDS), same
+      preset and seed, one after the other in this run; their ratios (target >= 4).
+    * The whole 150-raid dataset: every raid (0-4) of each sample house (``--houses``, default 20)
+      with the direct engine, one at a time; CPU seconds per square metre of floor, times the floor
+      area of all 30 houses (raid length grows with the area: grid nodes cover the free floor, the
+      wanderer walks room to room), divided by 1, this machine's cores, 8 and 64 (raids are
+      independent single-process jobs: 150 of them keep 64 cores busy).
+    """
+    import resource
+    from pathlib import Path
+
+    from ravh_sim.dataset.build import PAPER_CAPTURES, BuildOptions, Job, raid_seed, run_job
+    from ravh_sim.dataset.raid import PRESETS, run_raid
+    from ravh_sim.world.house import available_houses, load_house
+
+    def floor_area(n: int) -> float:
+        return sum(room.area for room in load_house(n).rooms)
+
+    def children_cpu() -> float:
+        usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+        return usage.ru_utime + usage.ru_stime
+
+    sample = houses or [RAID_HOUSE]
+    with tempfile.TemporaryDirectory() as tmp:
+        root = Path(tmp)
+        direct = {(h, r): run_job(Job(h, r, raid_seed(h, r, None)), root / "direct", BuildOptions())
+                  for h in sorted(set(sample) | {RAID_HOUSE}) for r in range(len(PRESETS))
+                  if h in sample or r == 1}
+        cpu0 = children_cpu()
+        ros = run_raid(RAID_HOUSE, 1, root / "ros", fast=True, seed=raid_seed(RAID_HOUSE, 1, None), quiet=True)
+        ros_cpu = children_cpu() - cpu0
+    ours = direct[(RAID_HOUSE, 1)]
+    rates = {"direct_captures_per_s": ours["captures"] / ours["wall_s"],
+             "direct_captures_per_cpu_s": ours["captures"] / ours["cpu_s"],
+             "ros_captures_per_s": ros["captures"] / ros["wall_s"] if ros["wall_s"] else math.nan,
+             "ros_captures_per_cpu_s": ros["captures"] / ros_cpu if ros_cpu else math.nan}
+    sampled = [s for (h, _), s in direct.items() if h in sample]
+    sample_area = sum(floor_area(h) for h in sample)
+    total_area = sum(floor_area(n) for n in available_houses())
+    cpu_hours = sum(s["cpu_s"] for s in sampled) * total_area / sample_area / 3600
+    cores = os.cpu_count() or 1
+    return {
+        "house": RAID_HOUSE, "raid": 1, "load_average_1min": round(os.getloadavg()[0], 1),
+        "direct_captures": ours["captures"], "direct_wall_s": ours["wall_s"], "direct_cpu_s": ours["cpu_s"],
+        "ros_status": ros["status"], "ros_captures": ros["captures"], "ros_wall_s": ros["wall_s"],
+        "ros_cpu_s": round(ros_cpu, 1),
+        **{k: round(v, 2) for k, v in rates.items()},
+        "direct_over_ros_wall": round(rates["direct_captures_per_s"] / rates["ros_captures_per_s"], 2),
+        "direct_over_ros_cpu": round(rates["direct_captures_per_cpu_s"] / rates["ros_captures_per_cpu_s"], 2),
+        "direct_over_ros_target": RAID_RATIO_TARGET,
+        "sample_houses": sample,
+        "sample_raids": {f"house{h}_raid{r}": {k: s[k] for k in ("status", "captures", "wall_s", "cpu_s")}
+                         for (h, r), s in direct.items() if h in sample},
+        "sample_captures_per_cpu_s": round(sum(s["captures"] for s in sampled)
+                                           / sum(s["cpu_s"] for s in sampled), 2),
+        "floor_m2_sample": round(sample_area, 1), "floor_m2_all_houses": round(total_area, 1),
+        "dataset_captures_estimate": round(sum(s["captures"] for s in sampled) * total_area / sample_area),
+        "paper_captures": PAPER_CAPTURES,
+        "dataset_cpu_hours": round(cpu_hours, 2), "cores": cores,
+        "dataset_hours_this_machine": round(cpu_hours / cores, 2),
+        "dataset_hours_8_cores": round(cpu_hours / 8, 2), "dataset_hours_64_cores": round(cpu_hours / 64, 2),
+        "dataset_hours_target": DATASET_HOURS_TARGET,
+        "extrapolation": "CPU seconds per m2 of floor on the sample houses x floor area of all 30 houses, "
+                         "divided by the cores (independent raids, one process each)",
+    }

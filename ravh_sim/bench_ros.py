@@ -92,20 +92,3 @@ def bench_node(houses: list[int] | None = None, seconds: float = 10.0) -> dict[s
         "targets": TARGET,
         "detail": {"ours": ours, "default_dds": default},
     }
-
-
-def bench_raid(houses: list[int] | None = None) -> dict[str, Any]:
-    """Raid 1 (wanderer, day) with --fast: captures per wall second and sim seconds per wall second
-    (the speed versus real time; real time is 1.0 by definition, target >= 2)."""
-    import tempfile
-    from pathlib import Path
-
-    from ravh_sim.dataset.raid import run_raid
-    house = (houses or [15])[0]
-    with tempfile.TemporaryDirectory() as tmp:
-        summary = run_raid(house, 1, Path(tmp) / "raid", fast=True, quiet=True)
-    wall, sim = summary["wall_s"], summary["sim_s"]
-    return {"house": house, "raid": 1, "status": summary["status"], "captures": summary["captures"],
-            "rooms_visited": len(summary["rooms_visited"]), "wall_s": wall, "sim_s": sim,
-            "captures_per_wall_s": round(summary["captures"] / wall, 2) if wall else None,
-            "speed_vs_real_time": round(sim / wall, 2) if wall else None, "target_speed": 2.0}

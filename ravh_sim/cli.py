@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Callable
 
 from ravh_sim.bench import BENCHES
+from ravh_sim.dataset.build import add_parser as add_dataset_parser
 from ravh_sim.errors import UserError
 from ravh_sim.nodes.launch import NODES
 from ravh_sim.nodes.launch import main as launch_node
@@ -287,6 +288,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("dataset", type=Path, help="dataset folder written by the recorder")
     p.add_argument("-o", "--output", type=Path, required=True, help="PNG file")
     p.set_defaults(func=cmd_raid_summary)
+
+    add_dataset_parser(sub)
 
     from ravh_sim.eval.commands import register as register_eval
     register_eval(sub)

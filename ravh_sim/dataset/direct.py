@@ -6,7 +6,7 @@ recorder processes), stepped in lockstep: the behaviour is updated every control
 time, each capture it asks for is rendered and written at once, and physics steps as fast as the
 machine allows. Nothing here depends on wall time or thread timing, so the same house, settings
 and seed give byte-identical capture files and captures.jsonl (only dataset.json's ``created``
-and raid.json's ``wall_s`` say when and how fast it ran).
+and raid.json's ``wall_s`` and ``cpu_s`` say when and how fast it ran).
 
 The API other code calls::
 
@@ -26,7 +26,7 @@ from collections import deque
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any, Callable
 
 import numpy as np
 import yaml
@@ -35,6 +35,7 @@ from ravh_msgs_py import names
 from ravh_sim.behaviours.grid import GridSweep
 from ravh_sim.behaviours.wanderer import Wanderer
 from ravh_sim.behaviours.waypoints import ORDERS, Layout, grid_nodes, light_waypoints
+from ravh_sim.dataset import layout
 from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nav.follower import CONTROL_PERIOD, PathFollower
@@ -42,7 +43,6 @@ from ravh_sim.runtime import Agent, Rates, SimRuntime
 
 Pose2D = tuple[float, float, float]
 SETTINGS_FILE = "raid_settings.yaml"
-SUMMARY_FILE = "raid.json"
 MAX_SIM_S = 3600.0               # sim seconds after which a behaviour that never ends is stopped
 WRITES_IN_FLIGHT = 4             # captures encoded and written behind the renderer at most
 
@@ -82,7 +82,7 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
            max_sim_s: float = MAX_SIM_S, raid: dict[str, Any] | None = None, renderer: str = "auto",
            progress: Callable[[int], None] | None = None) -> dict[str, Any]:
     """Record one raid of ``house`` into the new folder ``out``; return its summary (also written
-    to ``out/raid.json``, the same keys as the ROS engine's).
+    to ``out/raid.json``: the ROS engine's keys, and ``cpu_s``, the CPU seconds this process used).
 
     behaviour: a spec, or "grid" / "wanderer" for the paper's parameters. settings: settings-file
     overrides (None: config/default.yaml). seed: every random choice (None: the settings' seed).
@@ -95,15 +95,14 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
     if isinstance(spec, WandererSpec) and spec.order not in ORDERS:
         raise UserError(f"wanderer order must be one of {', '.join(ORDERS)}, got {spec.order!r}")
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    settings_path = out / SETTINGS_FILE
-    settings_path.write_text(yaml.safe_dump(settings or {}, sort_keys=False))
-    start = time.monotonic()
-    runtime = SimRuntime(house, settings_path, seed, renderer=renderer, rates=Rates(0.0, 0.0, 0.0, 0.0))
-    try:
-        meta = {"house": runtime.house.number, "engine": "direct", "behaviour": _describe(spec),
-                "seed": runtime.world.settings.seed, **(raid or {})}
-        with DatasetWriter(out) as writer:
+    start, cpu_start = time.monotonic(), time.process_time()
+    with DatasetWriter(out) as writer:         # refuses a folder with a dataset before writing anything
+        settings_path = out / SETTINGS_FILE
+        settings_path.write_text(yaml.safe_dump(settings or {}, sort_keys=False))
+        runtime = SimRuntime(house, settings_path, seed, renderer=renderer, rates=Rates(0.0, 0.0, 0.0, 0.0))
+        try:
+            meta = {"house": runtime.house.number, "engine": "direct", "behaviour": _describe(spec),
+                    "seed": runtime.world.settings.seed, **(raid or {})}
             session = _Session(runtime, writer, progress)
             writer.write_meta(runtime.house.number, [session.agent.name], meta)
             writer.write_footprint(runtime.footprint())
@@ -112,13 +111,14 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
                 status = session.run(spec, max_captures, max_sim_s)
             finally:
                 session.finish_writes()
-        rows = session.rows
-    finally:
-        runtime.close()
+        finally:
+            runtime.close()
+    rows = session.rows
     summary = {**meta, "status": status, "captures": len(rows),
                "rooms_visited": sorted({r for r in rows if r}),
-               "wall_s": round(time.monotonic() - start, 1), "sim_s": round(session.sim_span, 1)}
-    (out / SUMMARY_FILE).write_text(json.dumps(summary, indent=1))
+               "wall_s": round(time.monotonic() - start, 1), "cpu_s": round(time.process_time() - cpu_start, 1),
+               "sim_s": round(session.sim_span, 1)}
+    layout.atomic_write(out / layout.RAID_JSON, (json.dumps(summary, indent=1) + "\n").encode())
     return summary
 
 
@@ -165,7 +165,7 @@ class _Session:
         end = self.runtime.time + max_sim_s
         while not behaviour.done:
             if self.runtime.time >= end:
-                return f"stopped at {max_sim_s:.0f} sim s"
+                return f"timed out after {max_sim_s:.0f} sim s"
             for _ in behaviour.update(dt):
                 self.capture()
                 if max_captures and len(self.rows) >= max_captures:
@@ -191,10 +191,10 @@ class _Session:
         cap, scan = rt.capture(agent), rt.scan(agent)
         x, y, yaw = agent.robot.pose
         room = rt.room_of(agent)
-        h, w = cap.rgb.shape[:2]
-        camera = {"width": w, "height": h, "K": [float(v) for v in np.asarray(cap.K).reshape(-1)],
-                  "D": [float(v) for v in cap.camera_info.D], "distortion_model": "plumb_bob",
-                  "frame_id": names.agent_name(names.CAMERA_OPTICAL_FRAME, agent.name, agent.first)}
+        info = cap.camera_info
+        camera = {"width": info.width, "height": info.height, "K": list(info.K), "D": list(info.D),
+                  "distortion_model": info.distortion_model,
+                  "frame_id": names.agent_name(info.frame_id, agent.name, agent.first)}
         if len(self._writes) >= WRITES_IN_FLIGHT:
             self._writes.popleft().result()          # re-raises a failed write here
         self._writes.append(self._worker.submit(

@@ -23,6 +23,7 @@ CAPTURES_JSONL = "captures.jsonl"      # one line per complete capture
 MAP_DIR = "map"                        # map.pgm + map.yaml (map_server format)
 MAP_NAME = "map"
 BAG_DIR = "bag"                        # rosbag2, MCAP storage
+RAID_JSON = "raid.json"                # a raid's summary, written when it ends (``ravh raid``, the engines)
 TMP_PREFIX = "."                       # temporary files are hidden: ".<name>.<pid>.tmp"
 
 #: Per-capture files: kind -> (folder, extension).

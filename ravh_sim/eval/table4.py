@@ -26,7 +26,8 @@ import numpy as np
 
 from ravh_sim.behaviours.waypoints import Layout, grid_nodes
 from ravh_sim.dataset.api import Dataset
-from ravh_sim.dataset.direct import SUMMARY_FILE, GridSpec, PosesSpec, WandererSpec, record
+from ravh_sim.dataset.direct import GridSpec, PosesSpec, WandererSpec, record
+from ravh_sim.dataset.layout import RAID_JSON
 from ravh_sim.errors import UserError
 from ravh_sim.eval.descriptors import Descriptor, describe, load_descriptor
 from ravh_sim.eval.localization import Localizer, errors, noisy_odometry
@@ -138,7 +139,7 @@ def _recording(folder: Path, house: int, light: Lighting, behaviour: GridSpec | 
     request = json.loads(json.dumps({"benchmark": "table4", "house": house, "sun_angle": light.sun_angle,
                                      "seed": seed, "behaviour": behaviour.name, "spec": asdict(behaviour),
                                      **limits}))
-    summary_path = folder / SUMMARY_FILE
+    summary_path = folder / RAID_JSON
     if summary_path.exists():
         if json.loads(summary_path.read_text()).get("request") == request:
             return Dataset(folder)

@@ -1,0 +1,338 @@
+"""``ravh dataset build``: the paper's raids for many houses into one folder, on one machine or many.
+
+Every (house, raid) runs the paper's preset (:data:`ravh_sim.dataset.raid.PRESETS`) into
+``OUT/houseNN/raidK`` in the dataset format, with the direct engine (one process per raid, no DDS)
+or the ROS engine (``ravh raid``'s three processes). Raids run on a local process pool, or as Ray
+tasks on a cluster (``--ray ADDRESS``; ``pip install ravh_sim[ray]``) whose nodes share OUT.
+
+The output folder is the only state: a raid whose raid.json says it finished is skipped, any other
+raid folder is an interrupted or failed run and is deleted before the raid runs again, so a build
+can be stopped at any moment and resumed with the same command. Progress counts the lines of the
+raids' captures.jsonl, so it covers every worker of a cluster with no messages between them.
+"""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import multiprocessing
+import os
+import shutil
+import sys
+import time
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Iterable, Iterator
+
+from ravh_sim.dataset import layout
+from ravh_sim.dataset.raid import PRESETS, preset_settings, run_raid
+from ravh_sim.errors import UserError
+
+ENGINES = ("direct", "ros")
+POLL_S = 0.5
+RAY_RETRIES = 2                         # a raid whose task fails is run again this many times
+# The paper's dataset (Table 2): 5 raids in each of 30 houses, about 113,000 captures in all.
+PAPER_RAIDS = 150
+PAPER_CAPTURES = 113_000
+
+
+@dataclass(frozen=True, order=True)
+class Job:
+    house: int
+    raid: int
+    seed: int
+
+    @property
+    def name(self) -> str:
+        return f"house{self.house:02d}/raid{self.raid}"
+
+
+@dataclass(frozen=True)
+class BuildOptions:
+    engine: str = "direct"
+    max_captures: int = 0               # per raid, 0: no limit (small test builds)
+    max_nodes: int = 0                  # grid raids: only this many nodes, 0: all
+
+
+def parse_numbers(text: str, valid: Iterable[int], what: str) -> list[int]:
+    """'1-30', '20,29' or '0-2,4' as a sorted list; numbers outside ``valid`` are a UserError."""
+    valid = set(valid)
+    numbers: set[int] = set()
+    for part in text.split(","):
+        try:
+            lo, _, hi = part.strip().partition("-")
+            first, last = int(lo), int(hi or lo)
+        except ValueError:
+            raise UserError(f"--{what}: {text!r} is not a list of numbers or ranges like 1-30,32") from None
+        numbers.update(range(first, last + 1))
+    unknown = sorted(numbers - valid)
+    if unknown or not numbers:
+        raise UserError(f"--{what}: no such {what} {unknown or text}; valid: {min(valid)}-{max(valid)}")
+    return sorted(numbers)
+
+
+def raid_seed(house: int, raid: int, base: int | None) -> int:
+    """The seed of one raid: ``ravh raid``'s default (house * 10 + raid), offset per base seed."""
+    return house * 10 + raid + (0 if base is None else base * 1000)
+
+
+def finished(folder: Path) -> dict[str, Any] | None:
+    """The summary of a raid that ran to its end (or to the limit it was given), else None."""
+    try:
+        summary = json.loads((folder / layout.RAID_JSON).read_text())
+    except (OSError, ValueError):
+        return None
+    status = str(summary.get("status", ""))
+    return summary if status == "done" or status.startswith("stopped at") else None
+
+
+def clear_unfinished(folder: Path) -> None:
+    """Delete what an interrupted or failed run left, so the raid starts from an empty folder."""
+    if folder.exists() and finished(folder) is None:
+        shutil.rmtree(folder)
+
+
+def run_job(job: Job, root: Path, options: BuildOptions) -> dict[str, Any]:
+    """One raid into ``root/houseNN/raidK`` (in a worker process or a Ray task)."""
+    out = root / job.name
+    clear_unfinished(out)                    # a retried task finds its own earlier attempt
+    preset = PRESETS[job.raid]
+    if options.engine == "ros":
+        return run_raid(job.house, job.raid, out, fast=True, seed=job.seed, max_captures=options.max_captures,
+                        max_nodes=options.max_nodes, quiet=True)
+    (out / "logs").mkdir(parents=True)
+    with _output_to(out / "logs" / "direct.log"):
+        from ravh_sim.dataset.direct import GridSpec, WandererSpec, record
+        spec = GridSpec(max_nodes=options.max_nodes) if preset.behaviour == "grid" else WandererSpec()
+        return record(out, job.house, spec, settings=preset_settings(preset, job.seed), seed=job.seed,
+                      max_captures=options.max_captures, raid={"raid": job.raid, "preset": preset.__dict__})
+
+
+@contextlib.contextmanager
+def _output_to(log: Path) -> Iterator[None]:
+    """Send this process's stdout and stderr (pybullet's C-level banners included) to ``log`` for
+    the duration, so workers do not scribble over the progress bar."""
+    sys.stdout.flush(), sys.stderr.flush()
+    saved = os.dup(1), os.dup(2)
+    with open(log, "ab") as f:
+        os.dup2(f.fileno(), 1), os.dup2(f.fileno(), 2)
+        try:
+            yield
+        finally:
+            sys.stdout.flush(), sys.stderr.flush()
+            os.dup2(saved[0], 1), os.dup2(saved[1], 2)
+            os.close(saved[0]), os.close(saved[1])
+
+
+# ---------------------------------------------------------------------------- the build
+
+def build(root: Path, houses: list[int], raids: list[int], workers: int = 1, engine: str = "direct",
+          seed: int | None = None, ray_address: str | None = None, max_captures: int = 0,
+          max_nodes: int = 0, show_progress: bool = True) -> dict[str, Any]:
+    """Run every (house, raid) not yet finished under ``root``; returns every raid's summary and
+    the names of those that failed."""
+    if engine not in ENGINES:
+        raise UserError(f"--engine: unknown engine {engine!r}; valid: {', '.join(ENGINES)}")
+    if workers < 1:
+        raise UserError(f"--workers must be >= 1, got {workers}")
+    root.mkdir(parents=True, exist_ok=True)
+    jobs = [Job(h, r, raid_seed(h, r, seed)) for h in houses for r in raids]
+    done = {job: s for job in jobs if (s := finished(root / job.name)) is not None}
+    todo = [job for job in jobs if job not in done]
+    for job in todo:
+        clear_unfinished(root / job.name)
+    options = BuildOptions(engine, max_captures, max_nodes)
+    progress = Progress(root, todo, show_progress)
+    failed: dict[str, str] = {}
+
+    def on_result(job: Job, summary: dict[str, Any] | None, error: str | None) -> None:
+        if summary is not None and finished(root / job.name) is not None:
+            done[job] = summary
+        else:
+            failed[job.name] = error or f"status: {summary.get('status') if summary else 'none'}"
+        progress.raid_done(job)
+
+    start = time.monotonic()
+    try:
+        runner = _run_on_ray if ray_address else _run_on_pool
+        runner(todo, root, options, workers, ray_address, on_result, progress.poll)
+    finally:
+        progress.close()
+    summaries = [done[j] for j in jobs if j in done]
+    return {"raids": summaries, "skipped": len(jobs) - len(todo), "failed": failed,
+            "wall_s": round(time.monotonic() - start, 1)}
+
+
+OnResult = Callable[[Job, "dict[str, Any] | None", "str | None"], None]
+
+
+def _run_on_pool(todo: list[Job], root: Path, options: BuildOptions, workers: int, _address: str | None,
+                 on_result: OnResult, poll: Callable[[], None]) -> None:
+    """Local processes, a fresh one per raid (spawned: no pybullet or EGL state inherited)."""
+    if not todo:
+        return
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(min(workers, len(todo)), mp_context=context, max_tasks_per_child=1) as pool:
+        running: dict[Future, Job] = {pool.submit(run_job, job, root, options): job for job in todo}
+        try:
+            while running:
+                ready, _ = wait(running, timeout=POLL_S, return_when=FIRST_COMPLETED)
+                for future in ready:
+                    job = running.pop(future)
+                    error = future.exception()
+                    on_result(job, None if error else future.result(), _describe(error))
+                poll()
+        except BaseException:
+            for future in running:
+                future.cancel()
+            raise
+
+
+def _run_on_ray(todo: list[Job], root: Path, options: BuildOptions, _workers: int, address: str | None,
+                on_result: OnResult, poll: Callable[[], None]) -> None:
+    """One Ray task per raid (one CPU each), retried on failure; OUT must be shared by the nodes."""
+    try:
+        import ray
+    except ImportError:
+        raise UserError("--ray needs Ray: pip install 'ravh_sim[ray]'") from None
+    if not todo:
+        return
+    ray.init(address=address, logging_level="warning", log_to_driver=False)
+    try:
+        # max_calls=1: a fresh worker process per raid, as on the local pool (pybullet and EGL state
+        # of one raid never meets the next; in a process that started Ray, only its first World
+        # renders bit-exactly the images a fresh process does)
+        task = ray.remote(num_cpus=1, max_retries=RAY_RETRIES, retry_exceptions=True,
+                          max_calls=1)(_run_job_on_ray)
+        running = {task.remote(job, root, options): job for job in todo}
+        try:
+            while running:
+                ready, _ = ray.wait(list(running), num_returns=1, timeout=POLL_S)
+                for ref in ready:
+                    job = running.pop(ref)
+                    try:
+                        on_result(job, ray.get(ref), None)
+                    except ray.exceptions.RayError as e:
+                        on_result(job, None, _describe(e))
+                poll()
+        except BaseException:
+            for ref in running:                  # no task left writing into OUT after we stop
+                ray.cancel(ref, force=True)
+            raise
+    finally:
+        ray.shutdown()
+
+
+def _run_job_on_ray(job: Job, root: Path, options: BuildOptions) -> dict[str, Any]:
+    """:func:`run_job`, its summary naming the Ray node that ran it."""
+    import ray
+    return {**run_job(job, root, options), "ray_node": ray.get_runtime_context().get_node_id()}
+
+
+def _describe(error: BaseException | None) -> str | None:
+    if error is None:
+        return None
+    return f"{type(error).__name__}: {str(error).strip().splitlines()[-1] if str(error).strip() else ''}"
+
+
+class Progress:
+    """A tqdm bar over the raids to run, with the captures written so far (read from the raids'
+    captures.jsonl, wherever the worker runs), captures per second and tqdm's ETA."""
+
+    def __init__(self, root: Path, todo: list[Job], show: bool) -> None:
+        from tqdm import tqdm
+        self.root, self.open = root, set(todo)
+        self.closed_captures = 0
+        self.start = time.monotonic()
+        self.bar = tqdm(total=len(todo), unit="raid", disable=not show, file=sys.stderr,
+                        dynamic_ncols=True, smoothing=0.1)
+
+    def captures(self) -> int:
+        return self.closed_captures + sum(_lines(self.root / job.name / layout.CAPTURES_JSONL)
+                                          for job in self.open)
+
+    def poll(self) -> None:
+        captures = self.captures()
+        rate = captures / max(time.monotonic() - self.start, 1e-9)
+        self.bar.set_postfix_str(f"{captures} captures, {rate:.1f} captures/s", refresh=True)
+
+    def raid_done(self, job: Job) -> None:
+        self.open.discard(job)
+        self.closed_captures += _lines(self.root / job.name / layout.CAPTURES_JSONL)
+        self.bar.update(1)
+
+    def close(self) -> None:
+        self.poll()
+        self.bar.close()
+
+
+def _lines(path: Path) -> int:
+    try:
+        with open(path, "rb") as f:
+            return f.read().count(b"\n")
+    except OSError:
+        return 0
+
+
+# ---------------------------------------------------------------------------- the report
+
+def summary_table(result: dict[str, Any]) -> str:
+    """Captures per preset beside the paper's dataset (Table 2's total, scaled to these raids)."""
+    by_raid: dict[int, list[dict[str, Any]]] = {}
+    for s in result["raids"]:
+        by_raid.setdefault(int(s["raid"]), []).append(s)
+    lines = [f"{'raid':<5}{'preset':<40}{'raids':>6}{'captures':>10}{'per raid':>10}"]
+    for raid, rows in sorted(by_raid.items()):
+        p = PRESETS[raid]
+        preset = (f"{p.behaviour}, sun {p.sun}, ceiling {p.ceiling}, lamps {p.lamps}"
+                  + (", random look" if p.paint == "random" else ""))
+        captures = sum(r["captures"] for r in rows)
+        lines.append(f"{raid:<5}{preset:<40}{len(rows):>6}{captures:>10}{captures / len(rows):>10.0f}")
+    n = len(result["raids"])
+    total = sum(r["captures"] for r in result["raids"])
+    paper_per_raid = PAPER_CAPTURES / PAPER_RAIDS
+    lines.append(f"{'all':<45}{n:>6}{total:>10}{total / max(n, 1):>10.0f}")
+    lines.append(f"{'paper (Table 2), the same number of raids':<45}{n:>6}{paper_per_raid * n:>10.0f}"
+                 f"{paper_per_raid:>10.0f}   (~{PAPER_CAPTURES:,} captures in {PAPER_RAIDS} raids)")
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------------- the command
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    """``ravh dataset build ...`` (registered by ravh_sim.cli)."""
+    dataset = sub.add_parser("dataset", help="build the paper's dataset: many houses and raids at once")
+    commands = dataset.add_subparsers(metavar="COMMAND")
+    p = commands.add_parser("build", help="every (house, raid) into OUT/houseNN/raidK; resumable")
+    p.add_argument("--houses", default="1-30", help="houses, e.g. 1-30 or 20,29 (default 1-30)")
+    p.add_argument("--raids", default="0-4", help="paper presets 0-4 (default all): 0 grid/day, 1 wanderer/day, "
+                   "2 random paint+models, 3 sunset, 4 night")
+    p.add_argument("--out", type=Path, required=True, help="dataset folder (shared by the nodes with --ray)")
+    p.add_argument("--workers", type=int, default=1,
+                   help="raids at once on this machine (default 1; with --ray, Ray gives each raid a CPU)")
+    p.add_argument("--engine", choices=ENGINES, default="direct",
+                   help="direct: one process, no DDS (default); ros: sim, behaviour and recorder nodes")
+    p.add_argument("--seed", type=int, default=None,
+                   help="base seed (default: each raid's seed is house * 10 + raid, as ravh raid's)")
+    p.add_argument("--ray", metavar="ADDRESS", default=None,
+                   help="run the raids as tasks on this Ray cluster ('auto': the local one)")
+    p.add_argument("--max-captures", type=int, default=0, help="stop each raid after N captures (0: no limit)")
+    p.add_argument("--max-nodes", type=int, default=0, help="grid raids: visit only N nodes (0: all)")
+    p.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
+    p.set_defaults(func=cmd_build)
+    dataset.set_defaults(func=lambda args: dataset.print_help() or 2)
+
+
+def cmd_build(args: argparse.Namespace) -> int:
+    from ravh_sim.world.house import available_houses
+    houses = parse_numbers(args.houses, available_houses(), "houses")
+    raids = parse_numbers(args.raids, range(len(PRESETS)), "raids")
+    result = build(args.out, houses, raids, args.workers, args.engine, args.seed, args.ray,
+                   args.max_captures, args.max_nodes, args.progress)
+    print(summary_table(result))
+    print(f"{len(result['raids'])} raids in {args.out} ({result['skipped']} already there), "
+          f"{result['wall_s']:.0f} s")
+    for name, why in sorted(result["failed"].items()):
+        print(f"ravh: raid {name} failed: {why} (see {args.out / name})", file=sys.stderr)
+    return 1 if result["failed"] else 0
