@@ -26,7 +26,7 @@ def test_oracle_map_then_evaluation(capsys, tmp_path_factory, tmp_path):
     oracle, degraded = doc["houses"]
     assert oracle["precision"] >= 0.95 and oracle["recall"] >= 0.9
     assert degraded["recall"] < oracle["recall"]
-    assert (out / "semantic_map_house20.png").exists() and (out / "table3.txt").exists()
+    assert (out / "m_house20.png").exists() and (out / "d_house20.png").exists() and (out / "table3.txt").exists()
 
 
 @pytest.mark.parametrize("argv, needle", [

@@ -98,7 +98,7 @@ def test_ground_truth_from_a_dataset(tmp_path_factory, tmp_path):
     write_map(gt_map, tmp_path / "gt.json")
     doc = evaluate_datasets([(dataset.dir, tmp_path / "gt.json")], picture_dir=tmp_path)
     assert doc["houses"][0]["precision"] == doc["houses"][0]["recall"] == 1.0
-    assert (tmp_path / "semantic_map_house20.png").stat().st_size > 10_000
+    assert (tmp_path / "gt_house20.png").stat().st_size > 10_000
     result = evaluate(gt_map, truth, 20)
     assert draw_result(dataset, gt_map, result, truth).ndim == 3
     json.dumps(doc)

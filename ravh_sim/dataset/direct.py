@@ -191,16 +191,15 @@ class _Session:
         cap, scan = rt.capture(agent), rt.scan(agent)
         x, y, yaw = agent.robot.pose
         room = rt.room_of(agent)
-        h, w = cap.rgb.shape[:2]
-        camera = {"width": w, "height": h, "K": [float(v) for v in np.asarray(cap.K).reshape(-1)],
-                  "D": [float(v) for v in cap.camera_info.D], "distortion_model": "plumb_bob",
-                  "frame_id": names.agent_name(names.CAMERA_OPTICAL_FRAME, agent.name, agent.first)}
+        info = cap.camera_info
+        camera = {"width": info.width, "height": info.height, "K": list(info.K), "D": list(info.D),
+                  "distortion_model": info.distortion_model,
+                  "frame_id": names.agent_name(info.frame_id, agent.name, agent.first)}
         if len(self._writes) >= WRITES_IN_FLIGHT:
             self._writes.popleft().result()          # re-raises a failed write here
-        # copies: the writer thread must own its pixels (a sensor may reuse its buffers next frame)
         self._writes.append(self._worker.submit(
             self.writer.write_capture, rt.time, agent.name, (x, y, yaw), agent.robot.odometry, room,
-            cap.rgb.copy(), cap.depth.copy(), cap.instance.astype(np.uint16), scan.ranges.copy(),
+            cap.rgb, cap.depth, cap.instance.astype(np.uint16), scan.ranges,
             {"angle_min": float32(scan.angle_min), "angle_increment": float32(scan.angle_increment),
              "range_min": float32(scan.range_min), "range_max": float32(scan.range_max)}, camera))
         self.rows.append(room)

@@ -224,7 +224,7 @@ def evaluate_datasets(pairs: Sequence[tuple[Path, Path]], threshold: float = DEF
         result = evaluate(semantic_map, truth, int(dataset.meta["house"]), threshold)
         results.append(result)
         if picture_dir is not None:
-            write_plan(picture_dir / f"semantic_map_house{result.house:02d}.png",
+            write_plan(picture_dir / f"{map_path.stem}_house{result.house:02d}.png",
                        draw_result(dataset, semantic_map, result, truth))
     doc = table(results)
     doc["rules"]["threshold"] = threshold

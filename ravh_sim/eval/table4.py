@@ -26,7 +26,8 @@ import numpy as np
 
 from ravh_sim.behaviours.waypoints import Layout, grid_nodes
 from ravh_sim.dataset.api import Dataset
-from ravh_sim.dataset.direct import SUMMARY_FILE, GridSpec, PosesSpec, WandererSpec, record
+from ravh_sim.dataset.direct import GridSpec, PosesSpec, WandererSpec, record
+from ravh_sim.dataset.layout import RAID_JSON
 from ravh_sim.errors import UserError
 from ravh_sim.eval.descriptors import Descriptor, describe, load_descriptor
 from ravh_sim.eval.localization import Localizer, errors, noisy_odometry
@@ -61,7 +62,8 @@ class Protocol:
     grid_spacing: float = 0.5
     images_per_node: int = 10
     grid_nodes: int = 0            # 0: the whole house
-    route_m: float = 25.0
+    route_m: float = 25.0          # the Wanderer stops after route_m / SPEED s of sim time; its turns
+                                   # make the route shorter (house 15: 20.8 m)
     capture_period: float = 1.0    # s between route images
     map_near_route_m: float = 0.0  # > 0: the map is only the grid nodes this close to the first
                                    # route, captured in place (scripted poses): the CI-sized map
@@ -137,7 +139,7 @@ def _recording(folder: Path, house: int, light: Lighting, behaviour: GridSpec | 
     request = json.loads(json.dumps({"benchmark": "table4", "house": house, "sun_angle": light.sun_angle,
                                      "seed": seed, "behaviour": behaviour.name, "spec": asdict(behaviour),
                                      **limits}))
-    summary_path = folder / SUMMARY_FILE
+    summary_path = folder / RAID_JSON
     if summary_path.exists():
         if json.loads(summary_path.read_text()).get("request") == request:
             return Dataset(folder)
@@ -189,17 +191,22 @@ def draw_table4(doc: dict[str, Any]) -> np.ndarray:
     panels = [_panel(doc, "position_m", "position error (m)", "{:.2f}"),
               _panel(doc, "rotation_deg", "rotation error (deg)", "{:.1f}")]
     height = max(p.shape[0] for p in panels)
-    title = np.full((40, sum(p.shape[1] for p in panels) + GAP, 3), 255, np.uint8)
-    cv2.putText(title, f"House {doc['house']} localization ({doc['descriptor']}), median of {doc['runs']} runs",
-                (12, 28), FONT, 0.65, (40, 40, 40), 1, cv2.LINE_AA)
+    panels = [np.vstack([p, np.full((height - p.shape[0], p.shape[1], 3), 255, np.uint8)]) for p in panels]
     body = np.hstack([panels[0], np.full((height, GAP, 3), 255, np.uint8), panels[1]])
-    return np.vstack([title, body])
+    text = (f"House {doc['house']} localization ({doc['descriptor']}), median of {doc['runs']} runs; "
+            "colour from 0 (dark) to the largest value (yellow)")
+    width = max(body.shape[1], cv2.getTextSize(text, FONT, 0.55, 1)[0][0] + 24)
+    title = np.full((40, width, 3), 255, np.uint8)
+    cv2.putText(title, text, (12, 28), FONT, 0.55, (40, 40, 40), 1, cv2.LINE_AA)
+    return np.vstack([title, np.hstack([body, np.full((height, width - body.shape[1], 3), 255, np.uint8)])])
 
 
 def _panel(doc: dict[str, Any], key: str, heading: str, fmt: str) -> np.ndarray:
     rows, maps = doc["cells"], list(doc["maps"])
     values = np.array([[c[key] for c in row] for row in rows], float)
-    img = np.full((HEAD_H + CELL_H * len(rows) + 10, LABEL_W + CELL_W * len(maps) + 10, 3), 255, np.uint8)
+    heading_w = cv2.getTextSize(heading, FONT, 0.6, 1)[0][0]
+    width = LABEL_W + max(CELL_W * len(maps), heading_w) + 10
+    img = np.full((HEAD_H + CELL_H * len(rows) + 10, width, 3), 255, np.uint8)
     cv2.putText(img, heading, (LABEL_W, 22), FONT, 0.6, (40, 40, 40), 1, cv2.LINE_AA)
     top = values.max() if values.size and values.max() > 0 else 1.0
     colours = cv2.applyColorMap(np.uint8(np.clip(values / top, 0, 1) * 255).reshape(-1, 1), cv2.COLORMAP_VIRIDIS)
