@@ -21,10 +21,14 @@ import numpy as np
 from ravh_sim.world.facing import choose_facing
 from ravh_sim.world.furniture import build_parts, front_axis
 from ravh_sim.world.house import Door, House, HouseObject
-from ravh_sim.world.mesh import Mesh
+from ravh_sim.world.mesh import Mesh, box
+from ravh_sim.world.palette import PALETTE
+from ravh_sim.world.structure import doorway_ends
 
 DOOR_LEAF_THICKNESS = 0.05
 """m: the door leaf model's thickness (the doorway's frame is part of the walls)."""
+JAMB_COLOUR = "white"
+_Y = np.array([0.0, 1.0, 0.0])             # a door body's axis along the doorway
 
 Footprint = tuple[tuple[float, float], tuple[float, float], float]
 """A yawed rectangle on the floor: centre (x, y), size (along yaw, across), yaw."""
@@ -75,11 +79,17 @@ def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
 
 
 def door_parts(house: House, door: Door, model: int | None) -> Placed:
-    """The closed door leaf (see :func:`door_pose`)."""
+    """The closed door: its leaf (see :func:`door_pose`) and jambs from the leaf's edges to the wall
+    ends beside the doorway, where a leaf narrower than its gap in the walls would leave see-through
+    slits. The jambs go with the leaf: an open doorway keeps its whole width."""
     width, _, height = door.leaf
     variant = house.object(door.id).default_model if model is None else model
-    parts, bounds = _parts("Door", (DOOR_LEAF_THICKNESS, width, height), variant, 0, "")
-    return Placed(parts, bounds, *door_pose(house, door))
+    leaf, _ = _parts("Door", (DOOR_LEAF_THICKNESS, width, height), variant, 0, "")
+    left, right = doorway_ends(house, door)
+    jambs = tuple(box(((a + b) / 2 * _Y), (DOOR_LEAF_THICKNESS, b - a, height), PALETTE.index(JAMB_COLOUR))
+                  for a, b in ((left, -width / 2), (width / 2, right)) if b - a > 1e-4)
+    parts = leaf + jambs
+    return Placed(parts, np.array([part.bounds() for part in parts]), *door_pose(house, door))
 
 
 def door_pose(house: House, door: Door) -> tuple[tuple[float, float, float], float]:

@@ -9,8 +9,8 @@ The wall pieces built (:func:`solid_walls`, drawn, collided with and mapped alik
 that the upstream pieces leave at doorways: a lintel stops a few millimetres short of the wall
 pieces beside it, a door leaf is narrower than its gap in the walls, and walls end exactly at the
 floor and the ceiling, which let the sky or the ground show through thin slits. Lintels reach into
-their neighbours, door jambs fill the gap between a leaf's edges and the wall ends, and walls reach
-through the floor and the ceiling.
+their neighbours and walls reach through the floor and the ceiling; :func:`doorway_ends` tells a
+closed door how far its jambs must reach (see :func:`ravh_sim.world.solids.door_parts`).
 """
 from __future__ import annotations
 
@@ -32,14 +32,13 @@ JAMB_REACH = 0.1           # m beyond a doorway's frame where the wall ends besi
 
 
 def solid_walls(house: House, room_id: str) -> list[Wall]:
-    """The wall pieces built for a room: its walls and the jambs of the doors whose first room it is
-    (each door's jambs are built once), reaching through the floor and the ceiling where they meet
-    them, and its lintels lengthened into their neighbours."""
+    """The wall pieces built for a room: its walls, reaching through the floor and the ceiling where
+    they meet them, and its lintels lengthened into their neighbours."""
     room = house.room(room_id)
-    pieces = [w for w in house.walls if w.room == room_id]
-    pieces += [j for door in house.doors if door.rooms[0] == room_id for j in door_jambs(house, door)]
     walls = []
-    for w in pieces:
+    for w in house.walls:
+        if w.room != room_id:
+            continue
         if w.kind == "lintel":
             w = _lengthened(w, LINTEL_OVERLAP)
         if w.z0 <= room.floor_z + 1e-3:
@@ -50,19 +49,18 @@ def solid_walls(house: House, room_id: str) -> list[Wall]:
     return walls
 
 
-def door_jambs(house: House, door: Door) -> list[Wall]:
-    """Pieces from a door leaf's edges to the ends of the wall pieces beside the doorway (none where
-    the walls reach the leaf), through the doorway's whole depth, as high as the doorway."""
+def doorway_ends(house: House, door: Door) -> tuple[float, float]:
+    """Where the wall pieces beside a doorway end, along the door's ``yaw`` from its centre (at most
+    -leaf/2 and at least +leaf/2: where walls reach into the leaf, its edges)."""
     ux, uy = math.cos(door.yaw), math.sin(door.yaw)
-    nx, ny = -uy, ux
     cx, cy = door.position[:2]
     floor = min(house.room(r).floor_z for r in door.rooms)
     half_leaf, half_frame = door.leaf[0] / 2, door.width / 2
-    left, right = -half_leaf, half_leaf                 # wall ends beside the doorway, along ``yaw``
+    left, right = -half_leaf, half_leaf
     for w in house.walls:
         if w.kind == "lintel" or w.room not in door.rooms or w.z0 > floor + door.leaf[2]:
             continue
-        ends = [((x - cx) * ux + (y - cy) * uy, (x - cx) * nx + (y - cy) * ny) for x, y in (w.a, w.b)]
+        ends = [((x - cx) * ux + (y - cy) * uy, (x - cx) * -uy + (y - cy) * ux) for x, y in (w.a, w.b)]
         if any(abs(across) > (door.thickness + w.thickness) / 2 for _, across in ends):
             continue                                    # not a wall of this doorway
         lo, hi = sorted(along for along, _ in ends)
@@ -70,13 +68,7 @@ def door_jambs(house: House, door: Door) -> list[Wall]:
             left = min(left, hi)
         if half_leaf <= lo <= half_frame + JAMB_REACH:
             right = max(right, lo)
-    top = floor + door.leaf[2]
-    jambs = []
-    for a, b in ((left, -half_leaf), (half_leaf, right)):
-        if b - a > 1e-4:
-            jambs.append(Wall((cx + a * ux, cy + a * uy), (cx + b * ux, cy + b * uy), door.thickness, floor,
-                              top, door.rooms[0], "jamb"))
-    return jambs
+    return left, right
 
 
 def _lengthened(w: Wall, by: float) -> Wall:
