@@ -4,8 +4,8 @@ The map is computed from the house model, not sensed, so navigation works from t
 agrees with the pybullet world by construction. Three steps, each its own function:
 
 1. :func:`obstacles` rasterises the house at one robot height: the union of the room floors (plus
-   open doorways) is the known area, everything else is UNKNOWN; wall pieces and door jambs as the
-   world builds them (:func:`ravh_sim.world.structure.solid_walls`), columns, closed door
+   open doorways) is the known area, everything else is UNKNOWN; wall pieces as the world builds
+   them (:func:`ravh_sim.world.structure.solid_walls`), columns, closed door
    leaves and the furniture parts that the robot's body would hit (legs, seats, a table top below
    the robot's height: :mod:`ravh_sim.world.solids`, the parts the world collides with) are
    OCCUPIED; the rest is FREE.
