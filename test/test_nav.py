@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import time
 
 import cv2
 import numpy as np
@@ -268,13 +267,6 @@ def test_inflate_and_distance_on_a_small_grid():
     assert grid.data[10, 13] == FREE                                          # input untouched
 
 
-def test_free_space_is_fast(houses):
-    for number in HOUSES:
-        t0 = time.perf_counter()
-        free_space(houses[number], {})
-        assert time.perf_counter() - t0 < 1.0, number
-
-
 # --------------------------------------------------------------------------- planner
 
 @pytest.mark.parametrize("number", [3, 5, 14, 23, 25])
@@ -429,14 +421,12 @@ def test_paths_keep_away_from_walls_where_there_is_room():
     assert straight.points == ((0.5, 0.4), (4.5, 0.4))
 
 
-def test_cross_house_plan_is_fast(houses):
+def test_cross_house_plan(houses):
+    """A long plan across house 23 (its speed is `ravh bench nav`'s business, not a test's)."""
     house = houses[23]
     grid = free_space(house, all_open(house))
     start, goal = house.station.position[:2], roomiest_point(grid, house.room("DressingRoom_1"))
-    plan_path(grid, start, goal)
-    t0 = time.perf_counter()
     path = plan_path(grid, start, goal)
-    assert time.perf_counter() - t0 < 0.5                  # typically ~25 ms; generous for CI
     assert path.length > 12.0 and len(path.points) < 30
 
 

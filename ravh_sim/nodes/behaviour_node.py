@@ -228,7 +228,10 @@ class BehaviourNode(Node):
         self._pending.discard(future)
         result = future.result()
         if result is None or not result.success:
-            self.get_logger().warning(f"capture failed: {getattr(result, 'message', 'no reply')}")
+            problem = f"capture failed: {getattr(result, 'message', 'no reply')}"
+            if self.wait_recorder:                 # every capture asked for must reach the dataset
+                raise UserError(problem)
+            self.get_logger().warning(problem)
         else:
             event = json.loads(result.message)
             event["reason"] = reason
