@@ -170,7 +170,10 @@ class GLRenderer:
         self.vaos: dict[str, object] = {}
         self._room_vaos: dict[str, tuple] = {}
         self._geometry_revision = -1
-        self._light_key: tuple | None = None
+        self._sun_angle: float | None = None
+        self._lights_on: frozenset[str] | None = None
+        self._shadowed: set[str] = set()                  # lights whose cube map is current
+        self._light_row = {lt.id: row for row, lt in enumerate(world.house.lights)}
         self._bounds = (np.zeros(3), np.ones(3))
         self._sun_matrix = np.eye(4)
 
@@ -187,27 +190,38 @@ class GLRenderer:
 
     # ------------------------------------------------------------------ scene state
     def _sync(self) -> None:
-        """Bring GPU geometry, light state and shadow maps up to date with the World."""
+        """Bring GPU geometry, light state and the light maps up to date with the World, redoing
+        only what a change touches: a new geometry revision (door, model, paint) redoes everything,
+        a new sun angle its shadow map and every probe, a switched light its own cube map and the
+        probes of the rooms it reaches."""
         world = self.world
-        geometry_changed = world.revision != self._geometry_revision
-        if geometry_changed:
+        if world.revision != self._geometry_revision:
             self._upload_geometry()
             self._geometry_revision = world.revision
             self._render_coverage()
-        on = tuple(sorted(k for k, v in world.settings.lights.items() if v))
-        key = (world.revision, world.settings.sun_angle, on)
-        if key != self._light_key:
-            sun = sun_light(world.settings.sun_angle)
-            lights = [lt for lt in world.house.lights if world.settings.lights.get(lt.id, False)][:MAX_LIGHTS]
-            self._upload_instances(sun, lights)
-            self._set_lighting(sun, lights)
-            if self.shadows:
-                self._render_sun_shadow(sun)
-                self._render_lamp_shadows(lights)
-            self._light_key = key
-            self._bind_textures()
-            if self.shadows:
-                self._render_probes()
+            self._lights_on, self._sun_angle = None, None
+            self._shadowed.clear()
+        on = frozenset(k for k, v in world.settings.lights.items() if v)
+        sun_changed = world.settings.sun_angle != self._sun_angle
+        if not sun_changed and on == self._lights_on:
+            return
+        switched = on ^ self._lights_on if self._lights_on is not None else None
+        sun = sun_light(world.settings.sun_angle)
+        lights = [lt for lt in world.house.lights if lt.id in on]
+        self._upload_instances(sun, lights)
+        self._set_lighting(sun, lights)
+        self._sun_angle, self._lights_on = world.settings.sun_angle, on
+        if not self.shadows:
+            return
+        if sun_changed:
+            self._render_sun_shadow(sun)
+        self._render_lamp_shadows([lt for lt in lights if lt.id not in self._shadowed])
+        self._bind_textures()
+        if sun_changed or switched is None:
+            self._render_probes([room.id for room in world.house.rooms])
+        else:
+            by_id = world.house.light_by_id
+            self._render_probes(sorted({r for lid in switched for r in self._lit_rooms(by_id[lid].room)}))
 
     def _upload_geometry(self) -> None:
         vertices = self.builder.build()
@@ -343,8 +357,8 @@ class GLRenderer:
         assert len(index) <= 32, "a light's room mask holds 32 rooms"
         camera_room = self.world.house.room_at(float(position[0]), float(position[1]))
         around = self._lit_rooms(camera_room.id) if camera_room is not None else set(index)
-        near = sorted((float(np.linalg.norm(np.asarray(lt.position) - position)), row, lt)
-                      for row, lt in enumerate(self._lights) if self._lit_rooms(lt.room) & around)
+        near = sorted((float(np.linalg.norm(np.asarray(lt.position) - position)), self._light_row[lt.id], lt)
+                      for lt in self._lights if self._lit_rooms(lt.room) & around)
         chosen = [(row, lt) for d, row, lt in near if d < FRAME_LIGHT_REACH][:FRAME_LIGHTS]
         positions = np.zeros((MAX_LIGHTS, 4), np.float32)
         powers = np.zeros((MAX_LIGHTS, 4), np.float32)
@@ -399,24 +413,24 @@ class GLRenderer:
         (self.vaos["shadow"] if room is None else self._room_vaos[room][0]).render()
 
     def _render_lamp_shadows(self, lights: list[Light]) -> None:
-        rows = max(len(lights), 1)
-        size = (6 * LAMP_TILE, rows * LAMP_TILE)
-        if self.atlas is None or self.atlas.size != size:
-            for obj in (self.atlas, self.atlas_fbo):
-                if obj is not None:
-                    obj.release()
+        """The cube shadow maps of ``lights``, each in its own row of the atlas (one row per light
+        of the house, so switching one light redraws only its row)."""
+        if self.atlas is None:
+            size = (6 * LAMP_TILE, max(len(self.world.house.lights), 1) * LAMP_TILE)
             self.atlas = self.ctx.texture(size, 1, dtype="f4")
             self.atlas.filter = (self.ctx.NEAREST, self.ctx.NEAREST)
             self.atlas_fbo = self.ctx.framebuffer([self.atlas], self.ctx.depth_renderbuffer(size))
+            self._set("u_atlas_texels", (float(size[0]), float(size[1])))
+            self._set("u_tile", float(LAMP_TILE))
         self.atlas_fbo.use()
-        self.atlas_fbo.viewport = (0, 0, *size)
-        self.atlas_fbo.clear(1e4, 1e4, 1e4, 1e4, depth=1.0)
-        for row, lt in enumerate(lights):
+        for lt in lights:
+            row = self._light_row[lt.id]
+            self.atlas_fbo.clear(1e4, 1e4, 1e4, 1e4, depth=1.0,
+                                 viewport=(0, row * LAMP_TILE, 6 * LAMP_TILE, LAMP_TILE))
             for face, matrix in enumerate(self._face_matrices(lt.range)):
                 self.atlas_fbo.viewport = (face * LAMP_TILE, row * LAMP_TILE, LAMP_TILE, LAMP_TILE)
                 self._draw_casters(matrix, np.asarray(lt.position), lt.room)
-        self._set("u_atlas_texels", (float(size[0]), float(size[1])))
-        self._set("u_tile", float(LAMP_TILE))
+            self._shadowed.add(lt.id)
 
     @staticmethod
     def _face_views() -> list[np.ndarray]:
@@ -428,39 +442,33 @@ class GLRenderer:
         projection = perspective(math.pi / 2, 1.0, 0.02, max(reach, 0.1))
         return [projection @ view for view in self._face_views()]
 
-    def _render_probes(self) -> None:
-        """Each room's reflection probe: the room seen from its middle in six directions, fully lit,
-        so mirrors and glossy surfaces reflect the room they are in."""
+    def _render_probes(self, rooms: list[str]) -> None:
+        """The reflection probes of ``rooms``: each room seen from its middle in six directions,
+        fully lit, so mirrors and glossy surfaces reflect the room they are in."""
         house = self.world.house
-        size = (6 * PROBE_TILE, len(house.rooms) * PROBE_TILE)
-        if self.probes is None or self.probes.size != size:
-            for obj in (self.probes, self.probe_fbo):
-                if obj is not None:
-                    obj.release()
+        if self.probes is None:
+            size = (6 * PROBE_TILE, len(house.rooms) * PROBE_TILE)
             self.probes = self.ctx.texture(size, 4, dtype="f2")
             self.probe_fbo = self.ctx.framebuffer([self.probes], self.ctx.depth_renderbuffer(size))
-        boxes = np.zeros((3, len(house.rooms), 4), np.float32)
+            self.probe_boxes = self._nearest_texture((len(house.rooms), 3), self._probe_boxes())
+            self._set("u_probe_texels", (float(size[0]), float(size[1])))
+            self._set("u_probe_tile", float(PROBE_TILE))
         projection = perspective(math.pi / 2, 1.0, 0.05, PROBE_FAR)
         self._set("u_probes_ready", 0)
         self.probe_fbo.use()
-        self.probe_fbo.viewport = (0, 0, *size)
-        self.probe_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         for row, room in enumerate(house.rooms):
-            points = np.asarray([p for poly in (room.floor, *room.extra_floors) for p in poly])
-            lo = (*points.min(axis=0), room.floor_z)
-            hi = (*points.max(axis=0), room.ceiling_z)
+            if room.id not in rooms:
+                continue
+            self.probe_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0,
+                                 viewport=(0, row * PROBE_TILE, 6 * PROBE_TILE, PROBE_TILE))
             x, y = polygon_centroid(room.floor)
             centre = np.array([x, y, room.floor_z + PROBE_HEIGHT])
-            boxes[:, row, :3] = (lo, hi, centre)
             self._set_frame_lights(centre)
             for face, view in enumerate(self._face_views()):
                 view = view.copy()
                 view[:3, 3] = -view[:3, :3] @ centre
                 self.probe_fbo.viewport = (face * PROBE_TILE, row * PROBE_TILE, PROBE_TILE, PROBE_TILE)
                 self._draw_probe_face(view, projection @ view, centre, room.id)
-        self.probe_boxes = self._replace(self.probe_boxes, self._nearest_texture((len(house.rooms), 3), boxes))
-        self._set("u_probe_texels", (float(size[0]), float(size[1])))
-        self._set("u_probe_tile", float(PROBE_TILE))
         self._set("u_probes_ready", 1)
 
     def _render_coverage(self) -> None:
@@ -497,6 +505,17 @@ class GLRenderer:
             texture.use(unit)
             self._set(name, unit, also=(self.sky_program,))
         self._set("u_room_box", self._room_box)
+
+    def _probe_boxes(self) -> np.ndarray:
+        """(3, rooms, 4): each room's box (floor outline's bounds, floor to ceiling) and probe centre."""
+        house = self.world.house
+        boxes = np.zeros((3, len(house.rooms), 4), np.float32)
+        for row, room in enumerate(house.rooms):
+            points = np.asarray([p for poly in (room.floor, *room.extra_floors) for p in poly])
+            x, y = polygon_centroid(room.floor)
+            boxes[:, row, :3] = ((*points.min(axis=0), room.floor_z), (*points.max(axis=0), room.ceiling_z),
+                                 (x, y, room.floor_z + PROBE_HEIGHT))
+        return boxes
 
     def _draw_probe_face(self, view: np.ndarray, view_proj: np.ndarray, eye: np.ndarray, room: str) -> None:
         """A probe face: every surface in one draw with the plain-pattern program (a reflection
