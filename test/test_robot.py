@@ -22,7 +22,8 @@ from ravh_sim.nav.navigation import Navigation
 from ravh_sim.nav.planner import Path, Unreachable, densify
 from ravh_sim.paths import ROBOTS_DIR
 from ravh_sim.robot.profile import load_profile
-from ravh_sim.robot.robot import Odometry, Robot, relative, wrap_angle
+from ravh_sim.poses import relative, wrap_angle
+from ravh_sim.robot.robot import Odometry, Robot
 from ravh_sim.robot.simulation import Simulation
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.scene import World

@@ -19,16 +19,17 @@ import pytest
 from ravh_msgs_py import names
 from ravh_sim.cli import main
 from ravh_sim.errors import UserError
-from ravh_sim.robot.profile import load_profile
 from ravh_sim.nav.follower import PathFollower, Status
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.nav.planner import Unreachable
+from ravh_sim.poses import quaternion_from_matrix
+from ravh_sim.robot.profile import load_profile
 from ravh_sim.robot.simulation import Simulation
 from ravh_sim.sensors.agreement import laser_minus_depth
 from ravh_sim.sensors.camera import CameraOptions, SmartCamera, projection_from_K
 from ravh_sim.sensors.imaging import encode_jpeg, jpeg_roundtrip
 from ravh_sim.sensors.laser import Laser
-from ravh_sim.sensors.mount import LINK_TO_OPTICAL, quaternion_from_matrix
+from ravh_sim.sensors.mount import LINK_TO_OPTICAL
 from ravh_sim.world.appearance import Appearance, sun_light
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.geometry import polygon_centroid

@@ -39,9 +39,9 @@ from ravh_sim.dataset import layout
 from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nav.follower import CONTROL_PERIOD, PathFollower
+from ravh_sim.poses import Pose2D
 from ravh_sim.runtime import Agent, Rates, SimRuntime
 
-Pose2D = tuple[float, float, float]
 SETTINGS_FILE = "raid_settings.yaml"
 MAX_SIM_S = 3600.0               # sim seconds after which a behaviour that never ends is stopped
 WRITES_IN_FLIGHT = 4             # captures encoded and written behind the renderer at most

@@ -57,6 +57,18 @@ class Grid:
         return inside
 
 
+def distance_to_obstacle(grid: Grid) -> np.ndarray:
+    """Metres (float32, grid shape) from each cell centre to the nearest non-FREE cell centre;
+    0 on non-FREE cells. On an inflated map this is the clearance beyond the robot radius."""
+    return distance_cells(grid.data) * np.float32(grid.resolution)
+
+
+def distance_cells(data: np.ndarray) -> np.ndarray:
+    """Cells from each cell centre to the nearest non-FREE cell centre (0 on non-FREE cells)."""
+    free = (data == FREE).astype(np.uint8)
+    return cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+
+
 def reachable(grid: Grid, start: tuple[float, float], snap: float = np.inf) -> np.ndarray:
     """FREE cells connected to the free cell nearest ``start`` (within ``snap`` metres; all False if
     none). 4-connected, as the planner moves: its diagonal steps need both orthogonal cells free."""

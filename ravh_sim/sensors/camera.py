@@ -21,6 +21,7 @@ import numpy as np
 import pybullet as pb
 
 from ravh_sim.files import atomic_write, write_image
+from ravh_sim.poses import quaternion_from_matrix
 from ravh_sim.render.gl_renderer import GLRenderer
 from ravh_sim.render.projection import SAMPLE_OFFSET, projection_from_K, view_matrix
 from ravh_sim.robot.profile import CameraSpec
@@ -32,7 +33,6 @@ from ravh_sim.sensors.mount import (
     floor_at,
     mount_position,
     mount_rotation,
-    quaternion_from_matrix,
 )
 from ravh_sim.world.appearance import sun_light
 from ravh_sim.world.scene import World

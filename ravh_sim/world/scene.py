@@ -26,10 +26,10 @@ import cv2
 import numpy as np
 import pybullet as pb
 
+from ravh_sim.poses import quaternion_from_yaw
 from ravh_sim.render.backend import resolve_backend
 from ravh_sim.world import paints
 from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances
-from ravh_sim.world.geometry import quaternion_from_yaw
 from ravh_sim.world.house import House, HouseObject, Wall
 from ravh_sim.world.mesh import Mesh, hulls_obj_text
 from ravh_sim.world.palette import PALETTE
