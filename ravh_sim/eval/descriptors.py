@@ -16,7 +16,7 @@ kernel, so no single strong edge dominates).
 from __future__ import annotations
 
 import importlib
-from typing import Callable, Iterable
+from collections.abc import Callable, Iterable
 
 import cv2
 import numpy as np

@@ -21,9 +21,10 @@ House rows pool all types; "mean" rows average the houses (Table 3's last row).
 from __future__ import annotations
 
 from collections import defaultdict
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import cv2
 import numpy as np

@@ -21,8 +21,9 @@ import json
 import math
 import os
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
@@ -43,8 +44,7 @@ from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.planner import Path as PlannedPath
 from ravh_sim.nav.planner import plan_path
 from ravh_sim.nodes import convert
-from ravh_sim.nodes.common import (COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, STATE_QOS, SimWatchdog,
-                                   quiet_after_shutdown)
+from ravh_sim.nodes.common import COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, STATE_QOS, SimWatchdog, quiet_after_shutdown
 from ravh_sim.poses import Pose2D, yaw_from_quaternion
 from ravh_sim.robot.profile import load_profile
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import array
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 from builtin_interfaces.msg import Time
