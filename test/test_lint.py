@@ -1,4 +1,5 @@
-"""The project's own checks as tests: ruff (ruff.toml) over the code and the tests."""
+"""The project's own checks as tests: ruff (ruff.toml) over the code and the tests, mypy (setup.cfg)
+over the packages."""
 from __future__ import annotations
 
 import subprocess
@@ -15,4 +16,9 @@ def _run(*command: str) -> subprocess.CompletedProcess:
 
 def test_ruff_finds_nothing():
     done = _run(str(TOOLS / "ruff"), "check", "--no-cache", "ravh_sim", "ravh_msgs_py", "test")
+    assert done.returncode == 0, done.stdout + done.stderr
+
+
+def test_mypy_finds_nothing():
+    done = _run(str(TOOLS / "mypy"), "ravh_sim", "ravh_msgs_py")
     assert done.returncode == 0, done.stdout + done.stderr

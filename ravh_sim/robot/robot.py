@@ -217,7 +217,7 @@ class Robot:
             if push is None:
                 break
             x, y = x + push[0], y + push[1]
-        self._command: tuple[float, float] = (0.0, 0.0)
+        self._command = (0.0, 0.0)
         self._read_state()
 
     def is_clear(self) -> bool:

@@ -134,7 +134,8 @@ class SmartCamera:
                     ) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
         """Position and quaternion (x, y, z, w) of the optical frame in the house frame (for TF)."""
         position, rotation = self.optical_pose(x, y, yaw, floor_z)
-        return tuple(float(v) for v in position), quaternion_from_matrix(rotation)
+        px, py, pz = (float(v) for v in position)
+        return (px, py, pz), quaternion_from_matrix(rotation)
 
     def project(self, points: np.ndarray, x: float, y: float, yaw: float,
                 floor_z: float | None = None) -> np.ndarray:
