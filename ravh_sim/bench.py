@@ -95,7 +95,7 @@ def bench_load(houses: list[int] | None = None) -> dict[str, Any]:
 
 def _bare_client() -> None:
     from ravh_sim.world.scene import connect, disconnect
-    disconnect(connect()[0])
+    disconnect(connect())
 
 
 def bench_nav(houses: list[int] | None = None) -> dict[str, Any]:

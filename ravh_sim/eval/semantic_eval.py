@@ -154,8 +154,8 @@ def table(results: Sequence[HouseResult]) -> dict[str, Any]:
     precisions = [r.total.precision for r in results if r.total.precision is not None]
     recalls = [r.total.recall for r in results if r.total.recall is not None]
     return {"houses": [r.to_dict() for r in results],
-            "mean": {"precision": _round(np.mean(precisions)) if precisions else None,
-                     "recall": _round(np.mean(recalls)) if recalls else None},
+            "mean": {"precision": _round(float(np.mean(precisions))) if precisions else None,
+                     "recall": _round(float(np.mean(recalls))) if recalls else None},
             "by_type": {t: c.to_dict() for t, c in sorted(by_type.items())},
             "rules": {"overlap": "intersection volume / smaller volume", "tolerance_m": TOLERANCE,
                       "detectable_pixels": MIN_PIXELS}}

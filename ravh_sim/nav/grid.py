@@ -44,7 +44,8 @@ class Grid:
 
     def cell_centres(self) -> tuple[np.ndarray, np.ndarray]:
         """(xs, ys): the house-frame centre of every cell, each of the grid's shape."""
-        rows, cols = np.indices(self.data.shape)
+        indices = np.indices(self.data.shape)
+        rows, cols = indices[0], indices[1]
         return (self.origin[0] + (cols + 0.5) * self.resolution,
                 self.origin[1] + (rows + 0.5) * self.resolution)
 

@@ -243,7 +243,7 @@ class World:
         self.visuals[body].paint = paint
         self.revision += 1
         if paints.is_texture(paint):
-            texture, rgba = self._texture(paint), [1, 1, 1, 1]
+            texture, rgba = self._texture(paint), [1.0, 1.0, 1.0, 1.0]
         else:
             texture, rgba = self._texture("white"), [c / 255 for c in paints.plain_rgb(paint)] + [1]
         self._set_look(body, texture, rgba)
