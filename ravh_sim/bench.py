@@ -10,7 +10,8 @@ import os
 import statistics
 import tempfile
 import time
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 LOAD_TARGET_S = 2.0
 TRIANGLE_TARGET_HOUSE23 = 60_000
@@ -33,9 +34,9 @@ def run(what: str, houses: list[int] | None = None) -> dict[str, Any]:
     return benches[what](houses=houses)
 
 
-def _timed(fn: Callable[[], Any]) -> tuple[float, Any]:
+def _timed(fn: Callable[..., Any], *args: Any) -> tuple[float, Any]:
     t0 = time.perf_counter()
-    value = fn()
+    value = fn(*args)
     return time.perf_counter() - t0, value
 
 
@@ -94,7 +95,7 @@ def bench_load(houses: list[int] | None = None) -> dict[str, Any]:
 
 def _bare_client() -> None:
     from ravh_sim.world.scene import connect, disconnect
-    disconnect(connect()[0])
+    disconnect(connect())
 
 
 def bench_nav(houses: list[int] | None = None) -> dict[str, Any]:
@@ -124,9 +125,8 @@ def bench_nav(houses: list[int] | None = None) -> dict[str, Any]:
     for n in houses or available_houses():
         house = load_house(n)
         resolved = resolve(settings, house)
-        raster_s, _ = _timed(lambda: obstacles(house, resolved.doors, resolved.models, profile.height))
-        map_s, _ = _timed(lambda: free_space(house, resolved.doors, resolved.models, profile.radius,
-                                             profile.height))
+        raster_s, _ = _timed(obstacles, house, resolved.doors, resolved.models, profile.height)
+        map_s, _ = _timed(free_space, house, resolved.doors, resolved.models, profile.radius, profile.height)
         per_house[str(n)] = {"free_space_s": round(map_s, 4), "obstacles_only_s": round(raster_s, 4)}
     map_times = [v["free_space_s"] for v in per_house.values()]
 
@@ -247,13 +247,13 @@ def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
                 appearance.set_lights("all", "on")
             camera = SmartCamera(world, replace(profile.camera, quality=quality))
             camera.capture(*poses[0])                         # shadow maps and buffers are made once
-            times = [_timed(lambda: camera.capture(*pose))[0] * 1000
+            times = [_timed(camera.capture, *pose)[0] * 1000
                      for _ in range(SENSOR_REPEATS) for pose in poses]
             camera_ms[name] += times
             detail[f"house{n}_camera_ms_{name}"] = round(statistics.median(times), 2)
             if name == "tiny":
                 laser = Laser(world, profile.laser)
-                scan_ms += [_timed(lambda: laser.scan(*pose))[0] * 1000
+                scan_ms += [_timed(laser.scan, *pose)[0] * 1000
                             for _ in range(SENSOR_REPEATS * 5) for pose in poses]
             camera.close()
             world.close()

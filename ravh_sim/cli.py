@@ -11,8 +11,8 @@ import json
 import os
 import sys
 from collections import Counter
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 from ravh_sim.bench import BENCHES
 from ravh_sim.dataset.build import add_parser as add_dataset_parser

@@ -5,6 +5,8 @@ print its message instead of a traceback. Code bugs stay ordinary exceptions.
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 
 class UserError(Exception):
     """A problem the user can fix: bad file, unknown name, invalid value."""
@@ -13,7 +15,7 @@ class UserError(Exception):
 class FileFieldError(UserError):
     """A malformed field in a data file; the message names the file and the field path."""
 
-    def __init__(self, path: str, field: str, problem: str) -> None:
+    def __init__(self, path: str | Path, field: str, problem: str) -> None:
         self.path, self.field, self.problem = str(path), field, problem
         super().__init__(f"{path}: {field}: {problem}")
 

@@ -20,13 +20,14 @@ from ravh_msgs_py.query import BAD_REQUEST, INTERNAL, MAX_COORDINATE, QueryError
 from ravh_sim.errors import UserError
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.nav.planner import Path as PlannedPath
+from ravh_sim.poses import compose, quaternion_from_matrix, relative
 from ravh_sim.robot.profile import RobotProfile, load_profile
-from ravh_sim.robot.robot import Robot, compose, relative
+from ravh_sim.robot.robot import Robot
 from ravh_sim.robot.simulation import Simulation
 from ravh_sim.schema import shown
 from ravh_sim.sensors.camera import CameraOptions, Capture, SmartCamera
 from ravh_sim.sensors.laser import Laser, Scan
-from ravh_sim.sensors.mount import LINK_TO_OPTICAL, mount_position, mount_rotation, quaternion_from_matrix
+from ravh_sim.sensors.mount import LINK_TO_OPTICAL, mount_position, mount_rotation
 from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import load_footprint, make_footprint
 from ravh_sim.world.ground_truth import GroundTruth

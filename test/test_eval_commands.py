@@ -4,8 +4,8 @@ from __future__ import annotations
 import json
 
 import pytest
-
 from evaldata import small_dataset
+
 from ravh_sim.cli import main
 from ravh_sim.eval.semantic_map import read_map
 

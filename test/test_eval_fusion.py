@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from evaldata import small_dataset
+
 from ravh_sim.dataset.api import Dataset
 from ravh_sim.eval.fusion import CameraModel, Detection, MapFuser, build_map
 from ravh_sim.eval.mappers import visible_objects

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from ravh_sim.eval.localization import Localizer, errors, noisy_odometry
-from ravh_sim.robot.robot import compose
+from ravh_sim.poses import compose
 
 
 def _map(seed: int = 0):

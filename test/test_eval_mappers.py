@@ -2,8 +2,8 @@
 from __future__ import annotations
 
 import pytest
-
 from evaldata import small_dataset
+
 from ravh_sim.dataset.api import Dataset
 from ravh_sim.errors import UserError
 from ravh_sim.eval.mappers import Degradation, run_mapper

@@ -6,12 +6,19 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-
 from evaldata import small_dataset
+
 from ravh_sim.dataset.api import MIN_PIXELS, Dataset
 from ravh_sim.errors import UserError
-from ravh_sim.eval.semantic_eval import (GroundTruthObject, draw_result, evaluate, evaluate_datasets,
-                                         format_table, ground_truth, table)
+from ravh_sim.eval.semantic_eval import (
+    GroundTruthObject,
+    draw_result,
+    evaluate,
+    evaluate_datasets,
+    format_table,
+    ground_truth,
+    table,
+)
 from ravh_sim.eval.semantic_map import LabelledBox, SemanticMap, write_map
 
 

@@ -8,8 +8,17 @@ import numpy as np
 import pytest
 
 from ravh_sim.errors import FileFieldError, UserError
-from ravh_sim.eval.semantic_map import (FORMAT, LabelledBox, SemanticMap, box_of_points, convex_overlap_area,
-                                        intersection_volume, iou, read_map, write_map)
+from ravh_sim.eval.semantic_map import (
+    FORMAT,
+    LabelledBox,
+    SemanticMap,
+    box_of_points,
+    convex_overlap_area,
+    intersection_volume,
+    iou,
+    read_map,
+    write_map,
+)
 
 
 def test_round_trip(tmp_path):

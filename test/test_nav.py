@@ -11,8 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ravh_sim.errors import UnknownNameError, UserError
-from ravh_sim.nav.freespace import distance_to_obstacle, free_space, inflate, obstacles
-from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid
+from ravh_sim.nav.freespace import free_space, inflate, obstacles
+from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid, distance_to_obstacle
 from ravh_sim.nav.mapio import read_map, write_map
 from ravh_sim.nav.planner import Path, Unreachable, densify, plan_path
 from ravh_sim.world.geometry import points_in_polygon

@@ -26,7 +26,8 @@ def blocking_area(house, settings, laser_top: float) -> float:
         if obj.type in ("Door", "Wall", "Light", "Station"):
             continue
         box, floor_z = obj.box(settings.models.get(obj.id)), house.room(obj.room).floor_z
-        if box.position[2] + box.size[2] / 2 > floor_z + 0.02 and box.position[2] - box.size[2] / 2 < floor_z + laser_top:
+        bottom, top = box.position[2] - box.size[2] / 2, box.position[2] + box.size[2] / 2
+        if top > floor_z + 0.02 and bottom < floor_z + laser_top:
             area += box.size[0] * box.size[1]
     return area
 

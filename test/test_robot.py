@@ -21,13 +21,14 @@ from ravh_sim.nav.mapio import read_map
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.nav.planner import Path, Unreachable, densify
 from ravh_sim.paths import ROBOTS_DIR
+from ravh_sim.poses import relative, wrap_angle
 from ravh_sim.robot.profile import load_profile
-from ravh_sim.robot.robot import Odometry, Robot, relative, wrap_angle
+from ravh_sim.robot.robot import Odometry, Robot
 from ravh_sim.robot.simulation import Simulation
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.scene import World
-from ravh_sim.world.solids import DOOR_LEAF_THICKNESS, object_parts
 from ravh_sim.world.settings import AgentSpec, resolve
+from ravh_sim.world.solids import DOOR_LEAF_THICKNESS, object_parts
 
 GIRAFF = load_profile("giraff")
 R = GIRAFF.radius

@@ -40,7 +40,8 @@ def test_nav2_uses_the_sims_frames_and_topics():
     assert (amcl["global_frame_id"], amcl["odom_frame_id"], amcl["base_frame_id"]) == (n.MAP_FRAME, n.ODOM_FRAME,
                                                                                        n.BASE_FRAME)
     assert amcl["scan_topic"] == n.SCAN and "/" + amcl["map_topic"] == n.MAP
-    for costmap, frame in (("global_costmap/global_costmap", n.MAP_FRAME), ("local_costmap/local_costmap", n.ODOM_FRAME)):
+    for costmap, frame in (("global_costmap/global_costmap", n.MAP_FRAME),
+                           ("local_costmap/local_costmap", n.ODOM_FRAME)):
         params = nodes[costmap]
         assert params["global_frame"] == frame and params["robot_base_frame"] == n.BASE_FRAME
         for layer in params["plugins"]:

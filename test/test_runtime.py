@@ -45,7 +45,7 @@ def test_commands_are_validated(runtime):
 
 
 def test_map_to_odom_composes_with_odometry_to_the_true_pose(runtime):
-    from ravh_sim.robot.robot import compose
+    from ravh_sim.poses import compose
     agent = runtime.agents[0]
     runtime.command(agent, 0.2, 0.3)
     runtime.step(480)

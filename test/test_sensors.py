@@ -18,21 +18,22 @@ import pytest
 from ravh_msgs_py import names
 from ravh_sim.cli import main
 from ravh_sim.errors import UserError
-from ravh_sim.robot.profile import load_profile
 from ravh_sim.nav.follower import PathFollower, Status
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.nav.planner import Unreachable
+from ravh_sim.poses import quaternion_from_matrix
+from ravh_sim.robot.profile import load_profile
 from ravh_sim.robot.simulation import Simulation
 from ravh_sim.sensors.camera import CameraOptions, SmartCamera, projection_from_K
 from ravh_sim.sensors.imaging import encode_jpeg, jpeg_roundtrip
 from ravh_sim.sensors.laser import Laser
-from ravh_sim.sensors.mount import LINK_TO_OPTICAL, quaternion_from_matrix
+from ravh_sim.sensors.mount import LINK_TO_OPTICAL
 from ravh_sim.world.appearance import Appearance, sun_light
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.house import HOUSE_FORMAT, house_from_dict
 from ravh_sim.world.scene import World
-from ravh_sim.world.solids import DOOR_LEAF_THICKNESS
 from ravh_sim.world.settings import load_settings, resolve
+from ravh_sim.world.solids import DOOR_LEAF_THICKNESS
 
 PROFILE = load_profile("giraff")
 WALL = 0.1
@@ -351,7 +352,7 @@ def test_the_laser_sees_between_legs(houses):
             c, s = math.cos(obj.yaw), math.sin(obj.yaw)
 
             def in_house(u: float, v: float) -> list[float]:
-                return [box.position[0] + c * u - s * v, box.position[1] + s * u + c * v, z]
+                return [box.position[0] + c * u - s * v, box.position[1] + s * u + c * v, z]  # noqa: B023 (used in this loop)
 
             starts, ends = [], []
             for t in np.linspace(-0.4, 0.4, 9):

@@ -91,8 +91,8 @@ def test_sim_serves_newcomers_through_churn_and_overload():
             got: list[Clock] = []
             t0 = time.monotonic()
             sub = node.create_subscription(Clock, n.CLOCK, got.append, STATE_QOS)
-            assert spin_until(node, lambda: bool(got), JOIN_TIMEOUT_S), \
-                f"join {joins}: no /clock in {JOIN_TIMEOUT_S} s\n{proc.log()[-3000:]}"
+            joined = spin_until(node, lambda: bool(got), JOIN_TIMEOUT_S)  # noqa: B023 (waited for here)
+            assert joined, f"join {joins}: no /clock in {JOIN_TIMEOUT_S} s\n{proc.log()[-3000:]}"
             waits.append(time.monotonic() - t0)
             node.destroy_subscription(sub)
             joins += 1

@@ -11,7 +11,7 @@ import math
 from ravh_sim.behaviours.waypoints import Point
 from ravh_sim.nav.follower import PathFollower, Status
 from ravh_sim.nav.planner import Unreachable
-from ravh_sim.robot.robot import wrap_angle
+from ravh_sim.poses import wrap_angle
 
 TURN_GAIN = 2.0                 # rad/s per rad of heading error
 HEADING_TOLERANCE = math.radians(2.0)

@@ -65,8 +65,8 @@ def light_waypoints(layout: Layout, grid: Grid, start: Point) -> dict[str, list[
                 r, c = nearest_free_cell(grid, xy, usable)
                 points.append(grid.center_of(r, c))
         if not points:
-            r, c = np.unravel_index(int(np.argmax(np.where(usable, clearance, -1))), grid.shape)
-            points.append(grid.center_of(int(r), int(c)))
+            row, col = np.unravel_index(int(np.argmax(np.where(usable, clearance, -1))), grid.shape)
+            points.append(grid.center_of(int(row), int(col)))
         out[room_id] = _dedupe(points, grid.resolution * 4)
     return out
 

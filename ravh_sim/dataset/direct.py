@@ -23,10 +23,11 @@ from __future__ import annotations
 import json
 import time
 from collections import deque
+from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import yaml
@@ -39,9 +40,9 @@ from ravh_sim.dataset import layout
 from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nav.follower import CONTROL_PERIOD, PathFollower
+from ravh_sim.poses import Pose2D
 from ravh_sim.runtime import Agent, Rates, SimRuntime
 
-Pose2D = tuple[float, float, float]
 SETTINGS_FILE = "raid_settings.yaml"
 MAX_SIM_S = 3600.0               # sim seconds after which a behaviour that never ends is stopped
 WRITES_IN_FLIGHT = 4             # captures encoded and written behind the renderer at most

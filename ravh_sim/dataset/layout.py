@@ -7,7 +7,6 @@ and renamed into place, so a reader (or a recorder killed at any instant) never 
 from __future__ import annotations
 
 import io
-import os
 from pathlib import Path
 
 import cv2

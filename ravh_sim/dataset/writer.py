@@ -12,9 +12,10 @@ import json
 import os
 import shutil
 import tempfile
-from datetime import datetime, timezone
+from collections.abc import Sequence
+from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -61,7 +62,7 @@ class DatasetWriter:
                    bag: bool = False) -> None:
         """dataset.json: what was recorded, when, and the caller's description of the raid."""
         meta = {"format": layout.FORMAT, "house": int(house), "agents": list(agents),
-                "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+                "created": datetime.now(UTC).isoformat(timespec="seconds"),
                 "raid": dict(raid or {}), "bag": layout.BAG_DIR if bag else None}
         layout.atomic_write(self.dir / layout.DATASET_JSON, (json.dumps(meta, indent=1) + "\n").encode())
 

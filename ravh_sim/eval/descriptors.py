@@ -16,7 +16,7 @@ kernel, so no single strong edge dominates).
 from __future__ import annotations
 
 import importlib
-from typing import Callable, Iterable
+from collections.abc import Callable, Iterable
 
 import cv2
 import numpy as np
@@ -43,7 +43,7 @@ def gradient_grid(image: np.ndarray) -> np.ndarray:
     cols, rows = CELLS
     h, w = small.shape
     cell = (np.arange(h)[:, None] * rows // h) * cols + (np.arange(w)[None, :] * cols // w)
-    hist = np.bincount((cell * ORIENTATIONS + bins).ravel(), weights=magnitude.ravel(),
+    hist: np.ndarray = np.bincount((cell * ORIENTATIONS + bins).ravel(), weights=magnitude.ravel(),
                        minlength=rows * cols * ORIENTATIONS).reshape(rows * cols, ORIENTATIONS)
     hist /= np.linalg.norm(hist, axis=1, keepdims=True) + CELL_EPS
     return np.sqrt(hist).ravel()
@@ -71,7 +71,7 @@ def load_descriptor(spec: str | None) -> tuple[str, Descriptor]:
 
 def describe(images: Iterable[np.ndarray], descriptor: Descriptor) -> np.ndarray:
     """(N, D) float32 L2-normalised descriptors of an iterable of RGB images."""
-    rows = []
+    rows: list[np.ndarray] = []
     for image in images:
         v = np.asarray(descriptor(image), np.float32).ravel()
         if rows and v.shape != rows[0].shape:

@@ -30,8 +30,8 @@ the same for every mapper:
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
-from typing import Callable, Iterable
 
 import cv2
 import numpy as np

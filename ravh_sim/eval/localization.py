@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ravh_sim.robot.robot import relative
+from ravh_sim.poses import relative
 
 TEMPERATURE = 0.02
 SPREAD_M = 0.25

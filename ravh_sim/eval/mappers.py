@@ -15,8 +15,8 @@ detector (:mod:`ravh_sim.eval.fusion`), so they exercise the whole pipeline:
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Callable
 
 import numpy as np
 

@@ -21,9 +21,10 @@ House rows pool all types; "mean" rows average the houses (Table 3's last row).
 from __future__ import annotations
 
 from collections import defaultdict
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import cv2
 import numpy as np
@@ -153,8 +154,8 @@ def table(results: Sequence[HouseResult]) -> dict[str, Any]:
     precisions = [r.total.precision for r in results if r.total.precision is not None]
     recalls = [r.total.recall for r in results if r.total.recall is not None]
     return {"houses": [r.to_dict() for r in results],
-            "mean": {"precision": _round(np.mean(precisions)) if precisions else None,
-                     "recall": _round(np.mean(recalls)) if recalls else None},
+            "mean": {"precision": _round(float(np.mean(precisions))) if precisions else None,
+                     "recall": _round(float(np.mean(recalls))) if recalls else None},
             "by_type": {t: c.to_dict() for t, c in sorted(by_type.items())},
             "rules": {"overlap": "intersection volume / smaller volume", "tolerance_m": TOLERANCE,
                       "detectable_pixels": MIN_PIXELS}}

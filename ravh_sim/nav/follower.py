@@ -25,8 +25,8 @@ from typing import TYPE_CHECKING, Protocol
 
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.planner import Path, Point, Unreachable
+from ravh_sim.poses import Pose2D, wrap_angle
 from ravh_sim.robot.profile import RobotProfile
-from ravh_sim.robot.robot import Pose2D, wrap_angle
 
 if TYPE_CHECKING:
     from ravh_sim.robot.simulation import Simulation

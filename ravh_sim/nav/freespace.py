@@ -11,8 +11,8 @@ agrees with the pybullet world by construction. Three steps, each its own functi
    OCCUPIED; the rest is FREE.
 2. :func:`inflate` grows every non-free cell by the robot radius (a disc), so a FREE cell is a
    position where the whole robot disc fits: the planner can then treat the robot as a point.
-3. :func:`free_space` chains the two; :func:`distance_to_obstacle` gives the clearance the planner
-   uses to keep paths away from walls where there is room.
+3. :func:`free_space` chains the two; :func:`ravh_sim.nav.grid.distance_to_obstacle` gives the
+   clearance the planner uses to keep paths away from walls where there is room.
 
 Rasterisation uses cv2 polygon filling on sub-pixel coordinates: a few hundred shapes per house take
 milliseconds. An obstacle covers the cells whose centre lies inside it (see :func:`_fill_box`: house
@@ -33,7 +33,7 @@ import cv2
 import numpy as np
 
 from ravh_sim.errors import UnknownNameError
-from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid
+from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid, distance_cells
 from ravh_sim.world.geometry import box_corners
 from ravh_sim.world.house import Door, House, Wall
 from ravh_sim.world.solids import Footprint, object_parts
@@ -99,15 +99,9 @@ def inflate(grid: Grid, radius: float) -> Grid:
     if radius < 0:
         raise ValueError(f"radius must be >= 0, got {radius}")
     data = grid.data.copy()
-    within = _distance_cells(grid.data) - 0.5 <= radius / grid.resolution + 1e-6
+    within = distance_cells(grid.data) - 0.5 <= radius / grid.resolution + 1e-6
     data[(data == FREE) & within] = OCCUPIED
     return Grid(data, grid.origin, grid.resolution)
-
-
-def distance_to_obstacle(grid: Grid) -> np.ndarray:
-    """Metres (float32, grid shape) from each cell centre to the nearest non-FREE cell centre;
-    0 on non-FREE cells. On an inflated map this is the clearance beyond the robot radius."""
-    return _distance_cells(grid.data) * np.float32(grid.resolution)
 
 
 # --------------------------------------------------------------------------- shapes
@@ -179,12 +173,6 @@ def _pixels(points: np.ndarray, grid: Grid) -> np.ndarray:
     """cv2 fixed-point pixel coordinates of (n, 2) points in metres: cell centres on integers."""
     pixels = (points - np.asarray(grid.origin)) / grid.resolution - 0.5
     return np.round(pixels * _SCALE).astype(np.int32)
-
-
-def _distance_cells(data: np.ndarray) -> np.ndarray:
-    """Cells from each cell centre to the nearest non-FREE cell centre (0 on non-FREE cells)."""
-    free = (data == FREE).astype(np.uint8)
-    return cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
 
 
 # --------------------------------------------------------------------------- arguments

@@ -44,7 +44,8 @@ class Grid:
 
     def cell_centres(self) -> tuple[np.ndarray, np.ndarray]:
         """(xs, ys): the house-frame centre of every cell, each of the grid's shape."""
-        rows, cols = np.indices(self.data.shape)
+        indices = np.indices(self.data.shape)
+        rows, cols = indices[0], indices[1]
         return (self.origin[0] + (cols + 0.5) * self.resolution,
                 self.origin[1] + (rows + 0.5) * self.resolution)
 
@@ -55,6 +56,18 @@ class Grid:
         for poly in polygons:
             inside |= points_in_polygon(xs, ys, poly)
         return inside
+
+
+def distance_to_obstacle(grid: Grid) -> np.ndarray:
+    """Metres (float32, grid shape) from each cell centre to the nearest non-FREE cell centre;
+    0 on non-FREE cells. On an inflated map this is the clearance beyond the robot radius."""
+    return distance_cells(grid.data) * np.float32(grid.resolution)
+
+
+def distance_cells(data: np.ndarray) -> np.ndarray:
+    """Cells from each cell centre to the nearest non-FREE cell centre (0 on non-FREE cells)."""
+    free = (data == FREE).astype(np.uint8)
+    return cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
 
 
 def reachable(grid: Grid, start: tuple[float, float], snap: float = np.inf) -> np.ndarray:

@@ -17,8 +17,8 @@ from pathlib import Path as FilePath
 
 import numpy as np
 
-from ravh_sim.nav.freespace import distance_to_obstacle, free_space
-from ravh_sim.nav.grid import FREE, Grid, reachable
+from ravh_sim.nav.freespace import free_space
+from ravh_sim.nav.grid import FREE, Grid, distance_to_obstacle, reachable
 from ravh_sim.nav.mapio import write_map
 from ravh_sim.nav.obstaclemap import obstacle_map
 from ravh_sim.nav.planner import Path, Point, Unreachable, densify, plan_path

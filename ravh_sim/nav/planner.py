@@ -31,8 +31,7 @@ import cv2
 import numpy as np
 
 from ravh_sim.errors import UserError
-from ravh_sim.nav.freespace import distance_to_obstacle
-from ravh_sim.nav.grid import FREE, UNKNOWN, Grid
+from ravh_sim.nav.grid import FREE, UNKNOWN, Grid, distance_to_obstacle
 from ravh_sim.world.house import House
 
 Point = tuple[float, float]

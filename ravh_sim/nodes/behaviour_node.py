@@ -21,8 +21,9 @@ import json
 import math
 import os
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
@@ -43,8 +44,8 @@ from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.planner import Path as PlannedPath
 from ravh_sim.nav.planner import plan_path
 from ravh_sim.nodes import convert
-from ravh_sim.nodes.common import (COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, STATE_QOS, SimWatchdog,
-                                   quiet_after_shutdown)
+from ravh_sim.nodes.common import COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, STATE_QOS, SimWatchdog, quiet_after_shutdown
+from ravh_sim.poses import Pose2D, yaw_from_quaternion
 from ravh_sim.robot.profile import load_profile
 
 FIRST_AGENT = "robot"            # the default settings' agent; other agents' topics are prefixed
@@ -71,9 +72,9 @@ class RosRobot:
             self.on_pose(msg)
 
     @property
-    def pose(self) -> tuple[float, float, float]:
+    def pose(self) -> Pose2D:
         p = self.pose_msg.pose
-        return (p.position.x, p.position.y, 2.0 * math.atan2(p.orientation.z, p.orientation.w))
+        return (p.position.x, p.position.y, yaw_from_quaternion(p.orientation.z, p.orientation.w))
 
     def set_command(self, v: float, w: float) -> None:
         self.command = (float(v), float(w))

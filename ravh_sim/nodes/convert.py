@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import array
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 from builtin_interfaces.msg import Time
@@ -19,9 +19,7 @@ from sensor_msgs.msg import CameraInfo, CompressedImage, Image, LaserScan
 from std_msgs.msg import Header
 
 from ravh_sim.nav.grid import Grid
-from ravh_sim.world.geometry import quaternion_from_yaw
-
-Pose2D = tuple[float, float, float]
+from ravh_sim.poses import Pose2D, quaternion_from_yaw
 
 
 def stamp(seconds: float) -> Time:

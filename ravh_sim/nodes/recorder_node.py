@@ -28,10 +28,11 @@ import argparse
 import json
 import struct
 import time
+from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 import rclpy.clock
@@ -249,7 +250,8 @@ class RecorderNode(Node):
             self.bag.add_topic(sub.topic_name, msg_type, latched=False)
             self.topics[topic] = sub.topic_name
         SimWatchdog(self)
-        self.create_timer(0.5, self._check_writes, clock=rclpy.clock.Clock(clock_type=rclpy.clock.ClockType.STEADY_TIME))
+        self.create_timer(0.5, self._check_writes,
+                          clock=rclpy.clock.Clock(clock_type=rclpy.clock.ClockType.STEADY_TIME))
         self.log.info(f"waiting for {n.GROUND_TRUTH} to learn the house and its agents")
 
     # ------------------------------------------------------------------ set-up once the world is known

@@ -20,7 +20,8 @@ import json
 import math
 import time
 from collections import deque
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 from diagnostic_msgs.srv import AddDiagnostics
 from geometry_msgs.msg import PoseStamped, TransformStamped, Twist, TwistStamped
@@ -40,8 +41,15 @@ from ravh_msgs_py import names as n
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nodes import convert
-from ravh_sim.nodes.common import (COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS,
-                                   quiet_after_shutdown, run_node)
+from ravh_sim.nodes.common import (
+    COMMAND_QOS,
+    HANDOVER_QOS,
+    LATCHED_QOS,
+    SENSOR_QOS,
+    STATE_QOS,
+    quiet_after_shutdown,
+    run_node,
+)
 from ravh_sim.render.backend import BACKENDS
 from ravh_sim.runtime import Agent, Rates, SimRuntime
 from ravh_sim.sensors.imaging import encode_jpeg

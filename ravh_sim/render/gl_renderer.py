@@ -179,11 +179,13 @@ class GLRenderer:
 
     def release(self) -> None:
         """Free the GPU objects (the context stays: it belongs to the process)."""
-        for obj in (*self.scene_programs.values(), self.depth_program, self.sky_program, self.tonemap_program, self.shadow_program,
-                    self.coverage_program, self.meter_program, self.meter, self.meter_fbo, self.hdr, self.depth, self.instance, self.main_fbo, self.ldr,
+        for obj in (*self.scene_programs.values(), self.depth_program, self.sky_program, self.tonemap_program,
+                    self.shadow_program, self.coverage_program, self.meter_program, self.meter, self.meter_fbo,
+                    self.hdr, self.depth, self.instance, self.main_fbo, self.ldr,
                     self.ldr_fbo, self.sun_depth, self.sun_fbo, self.coverage_raw, self.coverage_fbo,
                     self.coverage, self.noise, self.room_map, self.room_light, self.instance_texture,
-                    self.probes, self.probe_fbo, self.probe_boxes, self.atlas, self.atlas_fbo, self.vbo, *self.vaos.values(),
+                    self.probes, self.probe_fbo, self.probe_boxes, self.atlas, self.atlas_fbo, self.vbo,
+                    *self.vaos.values(),
                     *(obj for subset in self._room_vaos.values() for obj in subset)):
             if obj is not None:
                 obj.release()

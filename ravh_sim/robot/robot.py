@@ -20,10 +20,9 @@ import random
 
 import pybullet as pb
 
+from ravh_sim.poses import Pose2D, compose, relative, wrap_angle
 from ravh_sim.robot.profile import RobotProfile
 from ravh_sim.world.scene import World
-
-Pose2D = tuple[float, float, float]                  # x, y (m), yaw (rad)
 
 GROUND_CLEARANCE = 0.02          # m between the floor and the collision cylinder
 MOTOR_FORCE_MARGIN = 2.0         # motor force/torque limit over what the acceleration limit needs
@@ -44,24 +43,6 @@ PLACE_ITERATIONS = 8             # rounds of pushing a new pose out of overlaps
 PLACE_TOLERANCE = 0.001          # m of overlap accepted at a new pose
 SLIDE_X, SLIDE_Y, TURN, POLE, HEAD = range(5)        # link (and joint) indices
 DRIVE_JOINTS = [SLIDE_X, SLIDE_Y, TURN]
-
-
-def wrap_angle(a: float) -> float:
-    """``a`` in [-pi, pi)."""
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
-
-
-def compose(a: Pose2D, b: Pose2D) -> Pose2D:
-    """The pose ``b`` (given in frame ``a``) in ``a``'s parent frame."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], wrap_angle(a[2] + b[2]))
-
-
-def relative(a: Pose2D, b: Pose2D) -> Pose2D:
-    """The pose ``b`` seen from ``a`` (both in one frame): ``compose(a, relative(a, b)) == b``."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    return (c * dx + s * dy, -s * dx + c * dy, wrap_angle(b[2] - a[2]))
 
 
 class Odometry:
@@ -236,7 +217,7 @@ class Robot:
             if push is None:
                 break
             x, y = x + push[0], y + push[1]
-        self._command: tuple[float, float] = (0.0, 0.0)
+        self._command = (0.0, 0.0)
         self._read_state()
 
     def is_clear(self) -> bool:

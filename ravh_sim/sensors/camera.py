@@ -21,6 +21,7 @@ import numpy as np
 import pybullet as pb
 
 from ravh_sim.files import atomic_write, write_image
+from ravh_sim.poses import quaternion_from_matrix
 from ravh_sim.render.gl_renderer import GLRenderer
 from ravh_sim.render.projection import SAMPLE_OFFSET, projection_from_K, view_matrix
 from ravh_sim.robot.profile import CameraSpec
@@ -32,7 +33,6 @@ from ravh_sim.sensors.mount import (
     floor_at,
     mount_position,
     mount_rotation,
-    quaternion_from_matrix,
 )
 from ravh_sim.world.appearance import sun_light
 from ravh_sim.world.scene import World
@@ -134,7 +134,8 @@ class SmartCamera:
                     ) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
         """Position and quaternion (x, y, z, w) of the optical frame in the house frame (for TF)."""
         position, rotation = self.optical_pose(x, y, yaw, floor_z)
-        return tuple(float(v) for v in position), quaternion_from_matrix(rotation)
+        px, py, pz = (float(v) for v in position)
+        return (px, py, pz), quaternion_from_matrix(rotation)
 
     def project(self, points: np.ndarray, x: float, y: float, yaw: float,
                 floor_z: float | None = None) -> np.ndarray:

@@ -13,7 +13,6 @@ milliseconds.
 """
 from __future__ import annotations
 
-
 import cv2
 import numpy as np
 

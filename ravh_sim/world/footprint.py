@@ -15,7 +15,8 @@ from typing import Any
 
 from ravh_sim.errors import FileFieldError
 from ravh_sim.files import atomic_write
-from ravh_sim.world.geometry import polygon_centroid, quaternion_from_yaw
+from ravh_sim.poses import quaternion_from_yaw
+from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import House
 from ravh_sim.world.settings import Resolved
 

@@ -104,11 +104,6 @@ def box_corners(center: tuple[float, float], size: tuple[float, float], yaw: flo
     return local @ rot.T + np.asarray(center)
 
 
-def quaternion_from_yaw(yaw: float) -> tuple[float, float, float, float]:
-    """(x, y, z, w) of a rotation about +z."""
-    return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
-
-
 def triangulate(poly: Polygon) -> list[tuple[int, int, int]]:
     """Ear-clipping triangulation of a simple polygon; triangles are counter-clockwise.
 

@@ -12,18 +12,18 @@ from __future__ import annotations
 import json
 import math
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import Annotated, Any, Iterator, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, Field, model_validator
 
 from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
 from ravh_sim.paths import HOUSES_DIR
 from ravh_sim.schema import Strict, number, read_text, shown, validate, vector
-from ravh_sim.world.geometry import (Polygon, distance_to_polygon, point_in_polygon, polygon_area,
-                                     self_intersection)
+from ravh_sim.world.geometry import Polygon, distance_to_polygon, point_in_polygon, polygon_area, self_intersection
 
 HOUSE_FORMAT = "ravh_sim/house@1"
 LIGHT_KINDS = ("ceiling", "lamp", "wall")

@@ -215,7 +215,7 @@ def rounded_box(center: Vec3, size: Vec3, colour: int, bevel: float) -> Mesh:
         return box(center, size, colour)
     signs = [(i, j, k) for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)]
     index = {}
-    vertices = []
+    vertices: list[np.ndarray] = []
     for corner in signs:
         for axis in range(3):
             point = np.array(corner) * (half - bevel)
@@ -239,7 +239,8 @@ def rounded_box(center: Vec3, size: Vec3, colour: int, bevel: float) -> Mesh:
 def _corner(axis: int, sign: int, u: int, su: int, w: int, sw: int) -> tuple[int, int, int]:
     corner = [0, 0, 0]
     corner[axis], corner[u], corner[w] = sign, su, sw
-    return tuple(corner)
+    x, y, z = corner
+    return (x, y, z)
 
 
 _PHI = (1.0 + 5.0 ** 0.5) / 2.0

@@ -7,7 +7,7 @@ A paint is a string: a plain colour name (``"white"``), a hex colour (``"#a0b0c0
 from __future__ import annotations
 
 import re
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 
@@ -56,7 +56,7 @@ def plain_rgb(paint: str) -> tuple[int, int, int]:
     return (int(paint[1:3], 16), int(paint[3:5], 16), int(paint[5:7], 16))
 
 
-@lru_cache(maxsize=None)
+@cache
 def texture_rgb(name: str) -> np.ndarray:
     """A seamless (TEXTURE_PX, TEXTURE_PX, 3) uint8 RGB image of texture ``name``."""
     rng = np.random.default_rng(TEXTURES.index(name) + 1)

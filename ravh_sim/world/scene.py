@@ -18,18 +18,18 @@ import hashlib
 import math
 import os
 import sys
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterable, Iterator
 
 import cv2
 import numpy as np
 import pybullet as pb
 
+from ravh_sim.poses import quaternion_from_yaw
 from ravh_sim.render.backend import resolve_backend
 from ravh_sim.world import paints
 from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances
-from ravh_sim.world.geometry import quaternion_from_yaw
 from ravh_sim.world.house import House, HouseObject, Wall
 from ravh_sim.world.mesh import Mesh, hulls_obj_text
 from ravh_sim.world.palette import PALETTE
@@ -243,7 +243,7 @@ class World:
         self.visuals[body].paint = paint
         self.revision += 1
         if paints.is_texture(paint):
-            texture, rgba = self._texture(paint), [1, 1, 1, 1]
+            texture, rgba = self._texture(paint), [1.0, 1.0, 1.0, 1.0]
         else:
             texture, rgba = self._texture("white"), [c / 255 for c in paints.plain_rgb(paint)] + [1]
         self._set_look(body, texture, rgba)

@@ -25,7 +25,6 @@ from ravh_sim.world.geometry import triangulate
 from ravh_sim.world.house import Door, House, Room, Wall, Window
 from ravh_sim.world.paints import TEXTURE_TILE_M
 
-
 LINTEL_OVERLAP = 0.05      # m a lintel reaches into the wall pieces at each of its ends
 SEAM_OVERLAP = 0.05        # m a wall piece reaching the floor (ceiling) goes below (above) it: no seam
 JAMB_REACH = 0.1           # m beyond a doorway's frame where the wall ends beside it are looked for

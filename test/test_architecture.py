@@ -1,0 +1,119 @@
+"""Dependencies point one way: processes that only navigate or run a behaviour load no simulator."""
+from __future__ import annotations
+
+import ast
+import pkgutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import ravh_sim.behaviours
+
+SIMULATOR_MODULES = ("pybullet", "moderngl", "ravh_sim.world.scene", "ravh_sim.world.furniture",
+                     "ravh_sim.robot.robot")
+ROOT = Path(__file__).resolve().parents[1]
+BEHAVIOUR_NODES = ["ravh_sim.nodes.behaviour_node", "ravh_sim.nodes.wanderer_node", "ravh_sim.nodes.grid_node",
+                   "ravh_sim.nodes.teleop_node"]
+BEHAVIOURS = [f"ravh_sim.behaviours.{m.name}" for m in pkgutil.iter_modules(ravh_sim.behaviours.__path__)]
+
+
+def _loaded_simulator_modules(modules: list[str]) -> list[str]:
+    """The simulator modules that importing ``modules`` in a fresh interpreter loads."""
+    probe = (f"import sys\nfor m in {modules!r}: __import__(m)\n"
+             f"print(','.join(m for m in {SIMULATOR_MODULES!r} if m in sys.modules))")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120,
+                          cwd=ROOT)
+    assert done.returncode == 0, done.stderr
+    return [m for m in done.stdout.strip().split(",") if m]
+
+
+@pytest.mark.parametrize("modules", [["ravh_sim.nav.follower"], BEHAVIOURS, BEHAVIOUR_NODES],
+                         ids=["follower", "behaviours", "behaviour_nodes"])
+def test_navigation_and_behaviours_load_no_simulator(modules):
+    assert len(modules) > 0
+    assert _loaded_simulator_modules(modules) == []
+
+
+def test_the_probe_sees_a_simulator_module_when_one_is_loaded():
+    loaded = _loaded_simulator_modules(["ravh_sim.robot.robot"])
+    assert "pybullet" in loaded and "ravh_sim.robot.robot" in loaded
+
+
+# --------------------------------------------------------------------------- import cycles
+
+PACKAGES = ("ravh_sim", "ravh_msgs_py")
+
+
+def _modules() -> dict[str, Path]:
+    """Every module of our packages by dotted name (a package by its name, for its __init__)."""
+    found = {}
+    for package in PACKAGES:
+        for path in sorted((ROOT / package).rglob("*.py")):
+            parts = path.relative_to(ROOT).with_suffix("").parts
+            found[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    return found
+
+
+def _imports(name: str, path: Path, modules: dict[str, Path]) -> set[str]:
+    """Our modules that ``name`` imports anywhere in its text: at the top, inside functions and under
+    TYPE_CHECKING alike (an import hidden in a function still makes the arrow point back), and the
+    packages those live in (importing a.b.c runs a/__init__ and a/b/__init__ first)."""
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    targets = set()
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import):
+            targets.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.rsplit(".", node.level - 1)[0] if node.level > 1 else package
+                base = f"{anchor}.{base}" if base else anchor
+            targets.add(base)
+            targets.update(f"{base}.{alias.name}" for alias in node.names)
+    found = set()
+    for target in targets:
+        parts = target.split(".")
+        found.update(".".join(parts[:i]) for i in range(1, len(parts) + 1))
+    return {t for t in found if t in modules and t != name and not name.startswith(t + ".")}
+
+
+def import_graph() -> dict[str, set[str]]:
+    modules = _modules()
+    return {name: _imports(name, path, modules) for name, path in modules.items()}
+
+
+def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
+    """One import cycle as [a, b, ..., a], or None (iterative depth-first search)."""
+    state: dict[str, int] = {}                      # 1 on the current path, 2 done
+    for root in sorted(graph):
+        if root in state:
+            continue
+        path, stack = [root], [iter(sorted(graph[root]))]
+        state[root] = 1
+        while stack:
+            nxt = next(stack[-1], None)
+            if nxt is None:
+                state[path.pop()] = 2
+                stack.pop()
+            elif state.get(nxt) == 1:
+                return path[path.index(nxt):] + [nxt]
+            elif nxt not in state:
+                state[nxt] = 1
+                path.append(nxt)
+                stack.append(iter(sorted(graph[nxt])))
+    return None
+
+
+def test_the_package_has_no_import_cycle():
+    graph = import_graph()
+    assert "ravh_sim.nav.follower" in graph and "ravh_sim.poses" in graph["ravh_sim.nav.follower"]
+    cycle = find_cycle(graph)
+    assert cycle is None, "import cycle: " + " -> ".join(cycle)
+
+
+def test_the_cycle_finder_finds_a_cycle():
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"b", "d"}, "d": set()}
+    assert find_cycle(graph) == ["b", "c", "b"]
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": set()}) is None
