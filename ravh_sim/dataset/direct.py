@@ -107,7 +107,7 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
             session = _Session(runtime, writer, progress)
             writer.write_meta(runtime.house.number, [session.agent.name], meta)
             writer.write_footprint(runtime.footprint())
-            writer.write_map(runtime.navigation.map())
+            writer.write_map(runtime.navigation.obstacle_map())      # what the ROS recorder gets on /map
             try:
                 status = session.run(spec, max_captures, max_sim_s)
             finally:
