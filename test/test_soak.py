@@ -48,6 +48,9 @@ if ok:
     future = client.call_async(AddDiagnostics.Request(load_namespace='{"query": "rooms"}'))
     rclpy.spin_until_future_complete(node, future, timeout_sec=30)
     reply = future.result().success if future.done() else None
+end = time.monotonic() + 10               # the node list fills in as discovery data arrives
+while "ravh_sim" not in node.get_node_names() and time.monotonic() < end:
+    rclpy.spin_once(node, timeout_sec=0.05)
 if sys.argv[1] == "hold":
     print("holding", flush=True)
     time.sleep(60)
