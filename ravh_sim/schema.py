@@ -8,10 +8,12 @@ problem; :func:`read_text` reads a file so that unreadable or non-UTF-8 files fa
 from __future__ import annotations
 
 import math
+import types
 from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
+from pydantic_core import ErrorDetails
 
 from ravh_sim.errors import FileFieldError, UserError
 
@@ -37,8 +39,8 @@ def number(ge: float | None = None, le: float | None = None, gt: float | None = 
 
 
 def vector(item: Any, n: int) -> Any:
-    """A fixed-length tuple field that files write as a list."""
-    return Annotated[tuple[(item,) * n], Field(strict=False)]
+    """A fixed-length tuple field that files write as a list (``tuple[item, ...n times]``, built at run time)."""
+    return Annotated[types.GenericAlias(tuple, (item,) * n), Field(strict=False)]
 
 
 def validate(model: type[M], data: Any, source: str | Path) -> M:
@@ -52,7 +54,7 @@ def validate(model: type[M], data: Any, source: str | Path) -> M:
         raise FileFieldError(str(source), "(top level)", "nested too deeply") from None
 
 
-def field_path(loc: tuple) -> str:
+def field_path(loc: tuple[int | str, ...]) -> str:
     """('agents', 0, 'start') -> 'agents[0].start'."""
     out = ""
     for part in loc:
@@ -60,7 +62,7 @@ def field_path(loc: tuple) -> str:
     return out or "(top level)"
 
 
-def _problem(error: dict) -> str:
+def _problem(error: ErrorDetails) -> str:
     msg = error["msg"].removeprefix("Value error, ")
     if error["type"] == "missing":
         return "missing"
