@@ -28,6 +28,8 @@ def encode_jpeg(rgb: np.ndarray, quality: int) -> bytes:
 def jpeg_roundtrip(rgb: np.ndarray, quality: int) -> np.ndarray:
     """The RGB image after JPEG compression at ``quality`` (its block artefacts included)."""
     bgr = cv2.imdecode(np.frombuffer(encode_jpeg(rgb, quality), np.uint8), cv2.IMREAD_COLOR)
+    if bgr is None:
+        raise RuntimeError("JPEG decoding failed")
     return cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)
 
 
