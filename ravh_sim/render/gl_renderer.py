@@ -25,7 +25,7 @@ import numpy as np
 
 from ravh_sim.render.backend import gl_context
 from ravh_sim.render.geometry import ATTRIBUTES, VERTEX_FORMAT, SceneBuilder
-from ravh_sim.render.materials import NOISE_TEXELS, PATTERN, TEXELS, MaterialTable, noise_volume, srgb_to_linear
+from ravh_sim.render.materials import NOISE_TEXELS, PATTERN, TEXELS, MaterialTable, noise_volume, srgb8_to_linear
 from ravh_sim.render.projection import look_at, orthographic, perspective, projection_from_K, view_matrix
 from ravh_sim.world.appearance import SunLight, sun_light
 from ravh_sim.world.geometry import polygon_centroid
@@ -328,7 +328,7 @@ class GLRenderer:
         sun_up = min(1.0, max(0.0, elevation / 2.0 + 0.5)) if sun.angle <= 180.0 else MOONLIGHT
         irradiance = SUN_IRRADIANCE * np.asarray(sun.gain) * sun_up
         outside = 1.0 if sun.angle <= 180.0 else 3 * MOONLIGHT
-        sky = np.asarray(srgb_to_linear(tuple(c / 255 for c in sun.sky))) * outside
+        sky = np.asarray(srgb8_to_linear(sun.sky)) * outside
         level = float(np.mean(sun.gain)) * outside
         uniforms = {
             "u_sun_dir": tuple(direction), "u_sun_irradiance": tuple(irradiance),

@@ -40,11 +40,19 @@ class Material:
 
 def srgb_to_linear(rgb: RGB) -> RGB:
     c = np.asarray(rgb, np.float64)
-    return tuple(float(v) for v in np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4))
+    r, g, b = (float(v) for v in np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4))
+    return r, g, b
+
+
+def srgb8_to_linear(rgb: tuple[int, int, int]) -> RGB:
+    """An 8-bit sRGB colour (a paint, the sky) as a linear colour."""
+    r, g, b = rgb
+    return srgb_to_linear((r / 255, g / 255, b / 255))
 
 
 def _scaled(rgb: RGB, k: float) -> RGB:
-    return tuple(min(1.0, c * k) for c in rgb)
+    r, g, b = rgb
+    return min(1.0, r * k), min(1.0, g * k), min(1.0, b * k)
 
 
 def palette_material(name: str, srgb: RGB) -> Material:
@@ -84,7 +92,7 @@ def paint_material(paint: str, surface: str) -> Material:
     finish on floors; texture paints are the material they name."""
     if paints.is_texture(paint):
         return _TEXTURE_PAINTS[paint]
-    c = srgb_to_linear(tuple(v / 255 for v in paints.plain_rgb(paint)))
+    c = srgb8_to_linear(paints.plain_rgb(paint))
     if surface == "floor":
         return Material(c, "concrete", 0.7, scale=1.5, variation=0.12, accent=_scaled(c, 0.8), bump=0.2)
     return Material(c, "plaster", 0.85, scale=3.0, variation=0.05, accent=_scaled(c, 0.9), bump=0.1)
