@@ -86,7 +86,7 @@ def _room_raster(house: House) -> tuple[np.ndarray, tuple[float, float]]:
 
 def _contacts(labels: np.ndarray) -> dict[tuple[int, int], np.ndarray]:
     """Cells where two different rooms touch (4-neighbourhood), grouped by room pair."""
-    out: dict[tuple[int, int], list[np.ndarray]] = {}
+    out: dict[tuple[int, int], list[tuple[np.intp, np.intp]]] = {}
     for da, db in (((slice(None), slice(0, -1)), (slice(None), slice(1, None))),
                    ((slice(0, -1), slice(None)), (slice(1, None), slice(None)))):
         a, b = labels[da], labels[db]
