@@ -123,7 +123,8 @@ def _output_to(log: Path) -> Iterator[None]:
         finally:
             sys.stdout.flush(), sys.stderr.flush()
             os.dup2(saved[0], 1), os.dup2(saved[1], 2)
-            os.close(saved[0]), os.close(saved[1])
+            for fd in saved:
+                os.close(fd)
 
 
 # ---------------------------------------------------------------------------- the build
