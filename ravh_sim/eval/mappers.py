@@ -23,7 +23,7 @@ import numpy as np
 from ravh_sim.dataset.api import MIN_PIXELS, Dataset, Sample
 from ravh_sim.errors import UserError
 from ravh_sim.eval.fusion import Detection, build_map
-from ravh_sim.eval.semantic_map import SemanticMap
+from ravh_sim.eval.semantic_map import SemanticMap, float3
 
 Detector = Callable[[Sample], list[Detection]]
 
@@ -64,14 +64,15 @@ def degraded_detector(dataset: Dataset, seed: int, errors: Degradation) -> Detec
         wrong = [t for t in types if t != true]
         label[i] = (None if missed < errors.miss
                     else wrong[other % len(wrong)] if confused < errors.confuse and wrong else true)
+    reported = {i: t for i, t in label.items() if t is not None}       # the label of each object not missed
 
     def detect(sample: Sample) -> list[Detection]:
         masks: dict[int, np.ndarray] = {}
         for i in visible_objects(dataset, sample):
-            if label[group[i]] is not None:
+            if group[i] in reported:
                 hit = sample.instance == i
                 masks[group[i]] = masks[group[i]] | hit if group[i] in masks else hit
-        return [Detection(label[g], mask) for g, mask in masks.items()]
+        return [Detection(reported[g], mask) for g, mask in masks.items()]
     return detect
 
 
@@ -99,8 +100,7 @@ def perturb(semantic_map: SemanticMap, seed: int, errors: Degradation) -> Semant
     for b in semantic_map.boxes:
         shift = rng.normal(0.0, errors.center_sigma, 3)
         scale = np.exp(rng.normal(0.0, errors.size_sigma, 3))
-        boxes.append(replace(b, center=tuple(float(c) for c in np.add(b.center, shift)),
-                             size=tuple(float(s) for s in np.multiply(b.size, scale))))
+        boxes.append(replace(b, center=float3(np.add(b.center, shift)), size=float3(np.multiply(b.size, scale))))
     return SemanticMap(semantic_map.house, boxes)
 
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -46,7 +46,8 @@ class LabelledBox:
 
     def grown(self, margin: float) -> LabelledBox:
         """The same box with ``margin`` added on every side."""
-        return LabelledBox(self.type, self.center, tuple(s + 2 * margin for s in self.size), self.yaw,
+        sx, sy, sz = self.size
+        return LabelledBox(self.type, self.center, (sx + 2 * margin, sy + 2 * margin, sz + 2 * margin), self.yaw,
                            self.score, self.captures)
 
     def contains(self, points: np.ndarray) -> np.ndarray:
@@ -109,7 +110,7 @@ def _box(path: str | Path, where: str, b: Any) -> LabelledBox:
         if (not isinstance(v, list) or len(v) != 3 or not all(_finite(x) for x in v)
                 or (positive and not all(x > 0 for x in v))):
             raise FileFieldError(path, f"{where}.{key}", f"expected 3 {'positive ' if positive else ''}numbers")
-        return tuple(float(x) for x in v)
+        return float3(v)
 
     def number(key: str, default: float) -> float:
         v = b.get(key, default)
@@ -169,6 +170,12 @@ def convex_overlap_area(p: np.ndarray, q: np.ndarray) -> float:
 def _area(poly: np.ndarray) -> float:
     x, y = poly[:, 0], poly[:, 1]
     return float(abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) / 2)
+
+
+def float3(values: Iterable[Any]) -> tuple[float, float, float]:
+    """Three numbers (a box's centre or size) as the float 3-tuple a box holds."""
+    x, y, z = (float(v) for v in values)
+    return x, y, z
 
 
 def box_of_points(type_: str, points: np.ndarray, min_size: float, score: float = 1.0,
