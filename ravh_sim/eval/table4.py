@@ -27,7 +27,7 @@ import numpy as np
 
 from ravh_sim.behaviours.waypoints import Layout, grid_nodes
 from ravh_sim.dataset.api import Dataset
-from ravh_sim.dataset.direct import GridSpec, PosesSpec, WandererSpec, record
+from ravh_sim.dataset.direct import MAX_SIM_S, GridSpec, PosesSpec, WandererSpec, record
 from ravh_sim.dataset.layout import RAID_JSON
 from ravh_sim.errors import UserError
 from ravh_sim.eval.descriptors import Descriptor, describe, load_descriptor
@@ -126,6 +126,8 @@ def _map_spec(protocol: Protocol, route: Dataset) -> GridSpec | PosesSpec:
     number of headings per node."""
     if protocol.map_near_route_m <= 0:
         return GridSpec(protocol.grid_spacing, protocol.images_per_node, protocol.grid_nodes)
+    if route.map is None:
+        raise UserError(f"{route.dir}: the route recorded no occupancy map to place the map's nodes on")
     route_xy = np.array([s.pose[:2] for s in route])
     nodes = grid_nodes(Layout.of(route.house), route.map, tuple(route_xy[0]), protocol.grid_spacing)
     near = [n for n in nodes if np.hypot(*(route_xy - n).T).min() <= protocol.map_near_route_m]
@@ -147,7 +149,7 @@ def _recording(folder: Path, house: int, light: Lighting, behaviour: GridSpec | 
         raise UserError(f"{folder} holds a recording of other settings; use another --out or remove it")
     say(f"recording {behaviour.name} {light.label} into {folder}")
     summary = record(folder, house, behaviour, settings={"lights": {"sun_angle": light.sun_angle}}, seed=seed,
-                     raid={"request": request}, **limits)
+                     raid={"request": request}, max_sim_s=max_sim_s if max_sim_s > 0 else MAX_SIM_S)
     if not summary["captures"]:
         raise UserError(f"{folder}: the {behaviour.name} recorded no images ({summary['status']})")
     return Dataset(folder)
