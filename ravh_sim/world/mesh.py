@@ -18,7 +18,7 @@ from typing import Protocol
 
 import numpy as np
 
-Vec3 = Sequence[float]
+Vec3 = Sequence[float] | np.ndarray          # three floats, as a sequence or an array
 
 
 class UvSource(Protocol):
@@ -63,15 +63,17 @@ class Mesh:
         A mirroring matrix (negative determinant) also reverses the face
         winding so faces stay counter-clockwise seen from outside.
         """
-        matrix = rotation_z(rotation) if np.isscalar(rotation) else np.asarray(rotation, np.float64)
+        matrix = np.asarray(rotation, np.float64)
+        if matrix.ndim == 0:                                  # a yaw angle
+            matrix = rotation_z(float(matrix))
         faces = self.faces if np.linalg.det(matrix) > 0 else self.faces[:, ::-1]
         return Mesh(self.vertices @ matrix.T + np.asarray(translation, np.float64), faces, self.colours)
 
     def scaled(self, factors: Vec3 | float) -> Mesh:
         """Scale about the origin per axis; a mirroring scale also reverses the face winding."""
-        factors = np.broadcast_to(np.asarray(factors, np.float64), (3,))
-        faces = self.faces if np.prod(np.sign(factors)) > 0 else self.faces[:, ::-1]
-        return Mesh(self.vertices * factors, faces, self.colours)
+        per_axis = np.broadcast_to(np.asarray(factors, np.float64), (3,))
+        faces = self.faces if np.prod(np.sign(per_axis)) > 0 else self.faces[:, ::-1]
+        return Mesh(self.vertices * per_axis, faces, self.colours)
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Axis-aligned (min corner, max corner)."""
