@@ -27,7 +27,7 @@ SWAP_RATIO = 1.15
 """How much longer than the other a box axis must be before 'short'/'long' fronts care."""
 
 
-def suits_box(front: str, size: Sequence[float], facing: int) -> bool:
+def suits_box(front: str, size: Sequence[float] | np.ndarray, facing: int) -> bool:
     """Whether ``facing`` suits a type whose front belongs on a given side of its box.
 
     ``front`` is 'short' (the front looks across the box's short horizontal

@@ -732,8 +732,8 @@ def _kitchen(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
             xf, d, w, drawer, h, 'black')
     if 'sink' in name:
         top = h - 0.18 * (h - ph)
-        doors = _door_row(-w / 2, w / 2, ph, top, _count(w, 0.5, 1, 2), 'top')
-        fronts = [_Front(-w / 2, w / 2, top, h, 'drawer')] + doors
+        under_sink = _door_row(-w / 2, w / 2, ph, top, _count(w, 0.5, 1, 2), 'top')
+        fronts = [_Front(-w / 2, w / 2, top, h, 'drawer')] + under_sink
         return parts + _fronts(xf, d, fronts, finish)
     height = 'bottom' if wall else 'top'
     if 'corner' in name:  # a blind panel where the neighbouring run butts in
