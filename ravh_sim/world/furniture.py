@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ravh_sim.world.facing import suits_box
-from ravh_sim.world.mesh import Mesh, box, ellipsoid, frustum, rotation_y, rounded_box
+from ravh_sim.world.mesh import Mesh, Vec3, box, ellipsoid, frustum, rotation_y, rounded_box
 from ravh_sim.world.palette import PALETTE
 
 Parts = list[Mesh]
@@ -1358,7 +1358,7 @@ def front_axis(object_type: str) -> str:
     return _SPECS.get(object_type, _GENERIC).front
 
 
-def build_model(object_type: str, size: Sequence[float], variant: int, facing: int = 0,
+def build_model(object_type: str, size: Vec3, variant: int, facing: int = 0,
                 prefab: str = '') -> Mesh:
     """Model of ``object_type`` filling the upright box ``size`` (sx, sy, sz) centred at the origin.
 
@@ -1371,7 +1371,7 @@ def build_model(object_type: str, size: Sequence[float], variant: int, facing: i
     return Mesh.merged(build_parts(object_type, size, variant, facing, prefab))
 
 
-def build_parts(object_type: str, size: Sequence[float], variant: int, facing: int = 0,
+def build_parts(object_type: str, size: Vec3, variant: int, facing: int = 0,
                 prefab: str = '') -> Parts:
     """The parts ``build_model`` merges (same arguments, same placement in the box), one by one.
 
@@ -1390,7 +1390,7 @@ def build_parts(object_type: str, size: Sequence[float], variant: int, facing: i
     return [_fit(part, lo, hi, (d, w, h)).transformed(facing * np.pi / 2) for part in parts]
 
 
-def _clean_size(size: Sequence[float]) -> np.ndarray:
+def _clean_size(size: Vec3) -> np.ndarray:
     values = np.abs(np.asarray(size, np.float64).reshape(3))
     return np.maximum(np.where(np.isfinite(values), values, MIN_EXTENT), MIN_EXTENT)
 

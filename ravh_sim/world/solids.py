@@ -75,7 +75,7 @@ def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
     facing = _facing(tuple(box.position[:2]), obj.yaw, tuple(box.size), walls, front_axis(obj.type))
     variant = obj.default_model if model is None else model
     parts, bounds = _parts(obj.type, tuple(box.size), variant, facing, obj.prefab)
-    return Placed(parts, bounds, tuple(box.position), obj.yaw)
+    return Placed(parts, bounds, box.position, obj.yaw)
 
 
 def door_parts(house: House, door: Door, model: int | None) -> Placed:
