@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 import math
 import re
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -241,11 +241,11 @@ def load_house(house: int | str | Path, houses_dir: Path = HOUSES_DIR) -> House:
         raise FileFieldError(path, f"line {e.lineno} column {e.colno}", f"invalid JSON: {e.msg}") from None
     except RecursionError:
         raise FileFieldError(path, "(top level)", "nested too deeply") from None
-    house = house_from_dict(data, str(path))
+    loaded = house_from_dict(data, str(path))
     named = re.fullmatch(r"house(\d\d)\.json", path.name)
-    if named and int(named[1]) != house.number:
-        raise FileFieldError(path, "house", f"{house.number} disagrees with the file name {path.name}")
-    return house
+    if named and int(named[1]) != loaded.number:
+        raise FileFieldError(path, "house", f"{loaded.number} disagrees with the file name {path.name}")
+    return loaded
 
 
 # bounds that no real house comes near, so a unit or typing slip (1e12, 1e30) is refused at load
@@ -285,7 +285,7 @@ class _Room(Strict):
 
     @model_validator(mode="after")
     def _ceiling_above_floor(self) -> _Room:
-        if self.ceiling_z <= self.floor_z:
+        if float(self.ceiling_z) <= float(self.floor_z):      # float(): mypy cannot read Coord as a type
             raise ValueError(f"ceiling_z {self.ceiling_z} must be above floor_z {self.floor_z}")
         return self
 
@@ -303,7 +303,7 @@ class _Wall(Strict):
     def _proper(self) -> _Wall:
         if math.dist(self.a, self.b) < 1e-6:
             raise ValueError("zero-length wall (a == b)")
-        if self.z1 <= self.z0:
+        if float(self.z1) <= float(self.z0):
             raise ValueError(f"z1 {self.z1} must be above z0 {self.z0}")
         return self
 
@@ -407,7 +407,8 @@ def house_from_dict(data: Any, source: str) -> House:
         refs.object(f"doors[{i}].id", d.id)
         for j, r in enumerate(d.rooms):
             refs.room(f"doors[{i}].rooms[{j}]", r)
-    for kind, items in (("windows", f.windows), ("lights", f.lights)):
+    placed: dict[str, Sequence[_Window | _Light]] = {"windows": f.windows, "lights": f.lights}
+    for kind, items in placed.items():
         for i, item in enumerate(items):
             refs.object(f"{kind}[{i}].id", item.id)
             refs.room(f"{kind}[{i}].room", item.room)
@@ -426,7 +427,8 @@ def house_from_dict(data: Any, source: str) -> House:
         objects=tuple(_object(o) for o in f.objects),
         station=Station(f.station.position, f.station.yaw, f.station.object_id),
         source=dict(f.source))
-    if house.room_at(*f.station.position[:2]) is None:
+    x, y, _ = house.station.position
+    if house.room_at(x, y) is None:
         raise FileFieldError(source, "station.position", "outside every room")
     return house
 
