@@ -46,6 +46,7 @@ from ravh_sim.world.geometry import box_corners
 from ravh_sim.world.house import Door, House, HouseObject, ModelBox, Room, Window
 
 RGB = tuple[int, int, int]
+XY = Sequence[float] | np.ndarray          # a point (x, y), as a sequence or an array
 
 #: Floor colour (RGB) per room type; types not listed use :data:`DEFAULT_ROOM_COLOR`.
 ROOM_COLORS: dict[str, RGB] = {
@@ -156,7 +157,7 @@ class PlanFrame:
     def to_world(self, u: float, v: float) -> tuple[float, float]:
         return (self.xmin + (u - self.left) / self.scale, self.ymax - (v - self.top) / self.scale)
 
-    def to_px_array(self, points: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
+    def to_px_array(self, points: np.ndarray | Sequence[XY]) -> np.ndarray:
         p = np.asarray(points, dtype=float).reshape(-1, 2)
         return np.column_stack((self.left + (p[:, 0] - self.xmin) * self.scale,
                                 self.top + (self.ymax - p[:, 1]) * self.scale))
@@ -246,10 +247,13 @@ def _put_text(img: np.ndarray, text: str, org: tuple[int, int], font: int, scale
 def _beneath(img: np.ndarray, x0: int, y0: int, x1: int, y1: int) -> tuple[int, int, int]:
     """The median colour (BGR) of an image rectangle: the background a label is written on."""
     region = img[max(y0, 0):max(y1, 0), max(x0, 0):max(x1, 0)].reshape(-1, 3)
-    return tuple(int(v) for v in np.median(region, axis=0)) if region.size else (255, 255, 255)
+    if not region.size:
+        return 255, 255, 255
+    b, g, r = (int(v) for v in np.median(region, axis=0))
+    return b, g, r
 
 
-def _halo_text(img: np.ndarray, text: str, center: Sequence[float], font: int, scale: float,
+def _halo_text(img: np.ndarray, text: str, center: XY, font: int, scale: float,
                rgb: RGB) -> tuple[int, int, int, int]:
     """Centred one-line text over a halo of the colour beneath it; returns its rectangle."""
     w, h = _text_size(text, font, scale)
@@ -325,7 +329,7 @@ def _fix(points: np.ndarray) -> np.ndarray:
     return np.round(np.asarray(points, float) * (1 << SHIFT)).astype(np.int32).reshape(-1, 1, 2)
 
 
-def _fixp(point: Sequence[float]) -> tuple[int, int]:
+def _fixp(point: XY) -> tuple[int, int]:
     return (_fixr(point[0]), _fixr(point[1]))
 
 
@@ -355,7 +359,7 @@ def _dashed(img: np.ndarray, pts: np.ndarray, rgb: RGB, closed: bool, dash: floa
             t = t1 + gap
 
 
-def _arrow(img: np.ndarray, tail: Sequence[float], head: Sequence[float], rgb: RGB, thick: int,
+def _arrow(img: np.ndarray, tail: XY, head: XY, rgb: RGB, thick: int,
            tip: float = 0.35) -> None:
     cv2.arrowedLine(img, _fixp(tail), _fixp(head), _bgr(rgb), thick, AA, SHIFT, tip)
 
@@ -489,8 +493,8 @@ class _Painter:
     def free_space(self, grid: Grid) -> None:
         s, res = self.f.scale, grid.resolution
         ox, oy = grid.origin
-        m = np.float64([[res * s, 0, self.f.left + (ox + res / 2 - self.f.xmin) * s],
-                        [0, -res * s, self.f.top + (self.f.ymax - oy - res / 2) * s]])
+        m = np.array([[res * s, 0, self.f.left + (ox + res / 2 - self.f.xmin) * s],
+                      [0, -res * s, self.f.top + (self.f.ymax - oy - res / 2) * s]], np.float64)
         free = (grid.data == FREE).astype(np.uint8) * int(round(255 * FREE_ALPHA))
         _composite(self.img, 0, 0, cv2.warpAffine(free, m, (self.f.width, self.f.height),
                                                   flags=cv2.INTER_NEAREST), _bgr(FREE_RGB))
@@ -742,7 +746,7 @@ class _Painter:
         x0, y0, x1, y1 = rect
         self.taken[max(y0 - pad, 0):y1 + pad, max(x0 - pad, 0):x1 + pad] = 255
 
-    def _rect_of(self, text: str, centre: Sequence[float]) -> tuple[int, int, int, int]:
+    def _rect_of(self, text: str, centre: XY) -> tuple[int, int, int, int]:
         w, h = _text_size(text, SIMPLEX, _SMALL_TEXT * self.k)
         x0, y0 = int(round(centre[0] - w / 2)), int(round(centre[1] - h / 2))
         return x0, y0, x0 + w, y0 + h + 2
@@ -754,7 +758,7 @@ class _Painter:
             return False
         return not any(m[y0 - 1:y1 + 1, x0 - 1:x1 + 1].any() for m in masks)
 
-    def _place(self, candidates: Sequence[tuple[str, Sequence[float], int | None]], rgb: RGB) -> None:
+    def _place(self, candidates: Sequence[tuple[str, XY, int | None]], rgb: RGB) -> None:
         """Draw the first free candidate (text, centre, owner), if any; owner None: the spot must be
         clear of all furniture, else it must lie on that object's own visible box."""
         for text, centre, owner in candidates:
@@ -770,7 +774,7 @@ class _Painter:
                 return
 
     def _around(self, text: str, centre: np.ndarray, half: np.ndarray, gap: float = 3
-                ) -> list[tuple[str, Sequence[float], int | None]]:
+                ) -> list[tuple[str, XY, int | None]]:
         """Candidates just below, above, right and left of a box of half extents ``half`` (px)."""
         w, h = _text_size(text, SIMPLEX, _SMALL_TEXT * self.k)
         dy, dx = half[1] + gap + h / 2 + 1, half[0] + gap + w / 2
@@ -842,12 +846,12 @@ def _legend_rows(house: House, overlays: tuple[bool, bool, bool]) -> list[tuple[
                     key=list(GROUP_COLORS).index)
     objects = [(g, _swatch(GROUP_COLORS[g][1], GROUP_COLORS[g][0])) for g in groups]
     objects.append((f"overhead (> {OVERHEAD_Z:g} m)", _icon_overhead))
-    walls = [("wall", _icon_wall), ("lintel over doorway", _icon_lintel), ("window", _icon_window),
+    walls: list[_Row] = [("wall", _icon_wall), ("lintel over doorway", _icon_lintel), ("window", _icon_window),
              ("door, open", _icon_open_door), ("door, closed", _icon_closed_door)]
     if any(w.kind == "column" for w in house.walls):
         walls.insert(1, ("column", _swatch(COLUMN_RGB, WALL_RGB)))
     kinds = {lt.kind for lt in house.lights}
-    symbols = [(name, icon) for kind, name, icon in (
+    symbols: list[_Row] = [(name, icon) for kind, name, icon in (
         ("ceiling", "ceiling light", _icon_ceiling), ("lamp", "lamp", _icon_lamp),
         ("wall", "wall light", _icon_wall_light)) if kind in kinds]
     symbols.append(("robot station", _icon_station))
