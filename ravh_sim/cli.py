@@ -13,6 +13,7 @@ import sys
 from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from ravh_sim.bench import BENCHES
 from ravh_sim.dataset.build import add_parser as add_dataset_parser
@@ -80,7 +81,7 @@ def cmd_import_houses(args: argparse.Namespace) -> int:
 
 def cmd_houses(args: argparse.Namespace) -> int:
     from ravh_sim.world.house import available_houses, load_house
-    rows = []
+    rows: list[dict[str, Any]] = []
     for n in available_houses():
         h = load_house(n)
         rows.append({"house": n, "rooms": len(h.rooms), "objects": len(h.objects),
