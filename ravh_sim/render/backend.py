@@ -10,7 +10,10 @@ from __future__ import annotations
 
 import sys
 from functools import lru_cache
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import moderngl
 
 BACKENDS = ("auto", "gl", "tiny")
 QUALITIES = ("realistic", "fast")
@@ -31,11 +34,12 @@ def resolve_backend(requested: str) -> str:
 
 
 @lru_cache(maxsize=1)
-def gl_context() -> Any:
+def gl_context() -> moderngl.Context | None:
     """The process's moderngl context (EGL, headless), or None when none can be made."""
     try:
         import moderngl
-        ctx = moderngl.create_context(standalone=True, backend="egl", require=430)
+        # the ignore: moderngl's stub types every **settings value as a dict, but backend is a str
+        ctx = moderngl.create_context(standalone=True, backend="egl", require=430)  # type: ignore[arg-type]
     except Exception:                      # no libEGL, no driver, GL too old: all mean "no GL"
         return None
     return ctx

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from importlib import resources
+from typing import TYPE_CHECKING
 
 import cv2
 import numpy as np
@@ -32,6 +33,9 @@ from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import Light
 from ravh_sim.world.scene import World
 from ravh_sim.world.topology import room_index_raster, room_links
+
+if TYPE_CHECKING:
+    import moderngl
 
 KINDS = {"floor": 0, "ceiling": 1, "walls": 2, "object": 3, "door": 4, "window": 5}
 MAX_LIGHTS = 32                       # switched-on lights with a shadow map
@@ -85,9 +89,18 @@ def _header(pattern: int = -1) -> str:
     return "#version 430\n" + "\n".join(defines) + "\n" + _source("common.glsl") + "\n"
 
 
-def _either(texture, stand_in):
+def _either(texture: moderngl.Texture | None, stand_in: moderngl.Texture) -> moderngl.Texture:
     """A texture, or a stand-in bound in its place where a quality has none (never sampled then)."""
     return texture if texture is not None else stand_in
+
+
+def _uniform(program: moderngl.Program, name: str) -> moderngl.Uniform:
+    """``program``'s uniform ``name`` (indexing a program finds its attributes and blocks too)."""
+    import moderngl  # already loaded with the context (this module's import does not load it)
+    member = program[name]
+    if not isinstance(member, moderngl.Uniform):
+        raise TypeError(f"{name} is not a uniform of the program")
+    return member
 
 
 def _mat(m: np.ndarray) -> bytes:
@@ -153,22 +166,22 @@ class GLRenderer:
         self.noise = ctx.texture3d((NOISE_TEXELS,) * 3, 4, noise_volume().tobytes())
         self.noise.repeat_x = self.noise.repeat_y = self.noise.repeat_z = True
 
-        self.atlas = None
-        self.atlas_fbo = None
-        self.instance_texture = None
-        self.room_light = None
-        self.probes = None
-        self.probe_fbo = None
-        self.probe_boxes = None
+        self.atlas: moderngl.Texture | None = None
+        self.atlas_fbo: moderngl.Framebuffer | None = None
+        self.instance_texture: moderngl.Texture | None = None        # made by _upload_instances
+        self.room_light: moderngl.Texture | None = None
+        self.probes: moderngl.Texture | None = None
+        self.probe_fbo: moderngl.Framebuffer | None = None
+        self.probe_boxes: moderngl.Texture | None = None
         labels, origin = room_index_raster(world.house, ROOM_MAP_RESOLUTION)
         self.room_map = self._nearest_texture((labels.shape[1], labels.shape[0]), labels.astype(np.float32), 1)
         self.room_map.repeat_x = self.room_map.repeat_y = False
         height_m, width_m = np.asarray(labels.shape) * ROOM_MAP_RESOLUTION
         self._room_box = (origin[0] - ROOM_MAP_RESOLUTION / 2, origin[1] - ROOM_MAP_RESOLUTION / 2,
                           1.0 / width_m, 1.0 / height_m)
-        self.vbo = None
-        self.vaos: dict[str, object] = {}
-        self._room_vaos: dict[str, tuple] = {}
+        self.vbo: moderngl.Buffer | None = None
+        self.vaos: dict[str, moderngl.VertexArray] = {}
+        self._room_vaos: dict[str, tuple[moderngl.VertexArray, moderngl.VertexArray, moderngl.Buffer]] = {}
         self._geometry_revision = -1
         self._sun_angle: float | None = None
         self._lights_on: frozenset[str] | None = None
@@ -260,7 +273,8 @@ class GLRenderer:
         self.material_texture = self.ctx.texture((TEXELS, len(table)), 4, table.tobytes(), dtype="f4")
         self.material_texture.filter = (self.ctx.NEAREST, self.ctx.NEAREST)
 
-    def _room_subsets(self, vertices: np.ndarray) -> dict[str, tuple]:
+    def _room_subsets(self, vertices: np.ndarray
+                      ) -> dict[str, tuple[moderngl.VertexArray, moderngl.VertexArray, moderngl.Buffer]]:
         """Per room, (shadow VAO, probe VAO) over only the triangles of that room and the rooms open
         to it: what a lamp's shadow map or a room's probe can see (walls hide the rest), so those
         many small renders do not each process the whole house."""
@@ -298,12 +312,12 @@ class GLRenderer:
         self.room_light = self._replace(self.room_light, self._nearest_texture((len(house.rooms), 1), ambient))
 
     @staticmethod
-    def _replace(old, new):
+    def _replace(old: moderngl.Texture | None, new: moderngl.Texture) -> moderngl.Texture:
         if old is not None:
             old.release()
         return new
 
-    def _nearest_texture(self, size: tuple[int, int], data: np.ndarray, components: int = 4):
+    def _nearest_texture(self, size: tuple[int, int], data: np.ndarray, components: int = 4) -> moderngl.Texture:
         texture = self.ctx.texture(size, components, np.ascontiguousarray(data, np.float32).tobytes(), dtype="f4")
         texture.filter = (self.ctx.NEAREST, self.ctx.NEAREST)
         return texture
@@ -347,9 +361,9 @@ class GLRenderer:
         for program in (*self.scene_programs.values(), *also):
             if name in program:
                 if isinstance(value, bytes):
-                    program[name].write(value)
+                    _uniform(program, name).write(value)
                 else:
-                    program[name].value = value
+                    _uniform(program, name).value = value
 
     def _set_frame_lights(self, position: np.ndarray) -> None:
         """The lamps that can light this view: switched-on lights reaching the camera's room or a
@@ -409,15 +423,15 @@ class GLRenderer:
         ctx.enable(ctx.DEPTH_TEST)
         ctx.disable(ctx.CULL_FACE)
         self.material_texture.use(0)
-        self.shadow_program["u_materials"].value = 0
-        self.shadow_program["u_matrix"].write(_mat(matrix))
-        self.shadow_program["u_origin"].value = tuple(float(v) for v in origin)
+        _uniform(self.shadow_program, "u_materials").value = 0
+        _uniform(self.shadow_program, "u_matrix").write(_mat(matrix))
+        _uniform(self.shadow_program, "u_origin").value = tuple(float(v) for v in origin)
         (self.vaos["shadow"] if room is None else self._room_vaos[room][0]).render()
 
     def _render_lamp_shadows(self, lights: list[Light]) -> None:
         """The cube shadow maps of ``lights``, each in its own row of the atlas (one row per light
         of the house, so switching one light redraws only its row)."""
-        if self.atlas is None:
+        if self.atlas_fbo is None:
             size = (6 * LAMP_TILE, max(len(self.world.house.lights), 1) * LAMP_TILE)
             self.atlas = self.ctx.texture(size, 1, dtype="f4")
             self.atlas.filter = (self.ctx.NEAREST, self.ctx.NEAREST)
@@ -448,7 +462,7 @@ class GLRenderer:
         """The reflection probes of ``rooms``: each room seen from its middle in six directions,
         fully lit, so mirrors and glossy surfaces reflect the room they are in."""
         house = self.world.house
-        if self.probes is None:
+        if self.probe_fbo is None:
             size = (6 * PROBE_TILE, len(house.rooms) * PROBE_TILE)
             self.probes = self.ctx.texture(size, 4, dtype="f2")
             self.probe_fbo = self.ctx.framebuffer([self.probes], self.ctx.depth_renderbuffer(size))
@@ -486,9 +500,10 @@ class GLRenderer:
         ctx.disable(ctx.DEPTH_TEST)
         ctx.disable(ctx.CULL_FACE)
         self._upload_instances(sun_light(self.world.settings.sun_angle), [])
+        assert self.instance_texture is not None, "uploaded just above"
         self.instance_texture.use(0)
-        self.coverage_program["u_instances"].value = 0
-        self.coverage_program["u_matrix"].write(_mat(matrix))
+        _uniform(self.coverage_program, "u_instances").value = 0
+        _uniform(self.coverage_program, "u_matrix").write(_mat(matrix))
         self.vaos["coverage"].render()
         raw = np.frombuffer(self.coverage_raw.read(), np.float32).reshape(COVERAGE_TEXELS, COVERAGE_TEXELS)
         sigma = COVERAGE_BLUR_M * COVERAGE_TEXELS / span
@@ -498,11 +513,13 @@ class GLRenderer:
 
     # ------------------------------------------------------------------ frames
     def _bind_textures(self) -> None:
-        units = (("u_materials", self.material_texture), ("u_instances", self.instance_texture),
-                 ("u_sun_shadow", self.sun_depth), ("u_point_shadow", _either(self.atlas, self.depth)),
-                 ("u_coverage", self.coverage), ("u_noise", self.noise), ("u_room_map", self.room_map),
-                 ("u_room_light", self.room_light), ("u_probes", _either(self.probes, self.hdr)),
-                 ("u_probe_boxes", _either(self.probe_boxes, self.room_light)))
+        assert self.instance_texture is not None and self.room_light is not None, "_sync uploads them first"
+        units: tuple[tuple[str, moderngl.Texture | moderngl.Texture3D], ...] = (
+            ("u_materials", self.material_texture), ("u_instances", self.instance_texture),
+            ("u_sun_shadow", self.sun_depth), ("u_point_shadow", _either(self.atlas, self.depth)),
+            ("u_coverage", self.coverage), ("u_noise", self.noise), ("u_room_map", self.room_map),
+            ("u_room_light", self.room_light), ("u_probes", _either(self.probes, self.hdr)),
+            ("u_probe_boxes", _either(self.probe_boxes, self.room_light)))
         for unit, (name, texture) in enumerate(units):
             texture.use(unit)
             self._set(name, unit, also=(self.sky_program,))
@@ -530,7 +547,7 @@ class GLRenderer:
         ctx.depth_func = "<"
         self._room_vaos[room][1].render()
         ctx.depth_func = "<="
-        self.sky_program["u_inverse_view_proj"].write(_mat(np.linalg.inv(view_proj)))
+        _uniform(self.sky_program, "u_inverse_view_proj").write(_mat(np.linalg.inv(view_proj)))
         self.empty_vao.render(vertices=3)
 
     def _draw_view(self, view: np.ndarray, view_proj: np.ndarray, eye: np.ndarray) -> None:
@@ -544,13 +561,13 @@ class GLRenderer:
         ctx.disable(ctx.CULL_FACE)
         # Depth first, then shade only the surviving fragment of each pixel (no overdraw).
         ctx.depth_func = "<"
-        self.depth_program["u_view_proj"].write(_mat(view_proj))
+        _uniform(self.depth_program, "u_view_proj").write(_mat(view_proj))
         self.vaos["depth"].render()
         ctx.depth_func = "=="
         for k, first, count in self._ranges:
             self.vaos[f"scene{k}"].render(first=first, vertices=count)
         ctx.depth_func = "<="
-        self.sky_program["u_inverse_view_proj"].write(_mat(np.linalg.inv(view_proj)))
+        _uniform(self.sky_program, "u_inverse_view_proj").write(_mat(np.linalg.inv(view_proj)))
         self.empty_vao.render(vertices=3)
     def _exposure(self) -> float:
         """Auto-exposure: the frame's log-average luminance is metered and exposure makes up for
@@ -577,12 +594,12 @@ class GLRenderer:
         ctx.disable(ctx.DEPTH_TEST)
         self.hdr.use(0)
         self.meter_fbo.use()
-        self.meter_program["u_hdr"].value = 0
-        self.meter_program["u_block"].value = METER_BLOCK
+        _uniform(self.meter_program, "u_hdr").value = 0
+        _uniform(self.meter_program, "u_block").value = METER_BLOCK
         self.meter_vao.render(vertices=3)
         self.ldr_fbo.use()
-        self.tonemap_program["u_hdr"].value = 0
-        self.tonemap_program["u_exposure"].value = self._exposure() if exposure is None else exposure
+        _uniform(self.tonemap_program, "u_hdr").value = 0
+        _uniform(self.tonemap_program, "u_exposure").value = self._exposure() if exposure is None else exposure
         self.tonemap_vao.render(vertices=3)
         h, w = self.height, self.width
         rgb = np.frombuffer(self.ldr_fbo.read(components=3), np.uint8).reshape(h, w, 3)[::-1]
