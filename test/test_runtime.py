@@ -79,6 +79,19 @@ def test_appearance_requests_change_only_what_they_name(runtime):
     assert runtime.world.state.settings().to_dict() == runtime.initial.to_dict()
 
 
+def test_the_map_version_moves_with_doors_and_models_only(runtime):
+    """The node republishes /map when the map version moves: not for paint, sun or lights."""
+    before = runtime.map_version
+    reply = runtime.change_appearance({"paint": {"all": {"walls": "brick"}}, "sun_angle": "night",
+                                       "lights": {"all": "on"}})
+    assert reply["ok"], reply
+    assert runtime.map_version == before
+    is_open = runtime.world.state.doors["Door_1"]
+    assert runtime.change_appearance({"doors": {"Door_1": not is_open}})["ok"]
+    assert runtime.map_version > before
+    runtime.reset()
+
+
 @pytest.mark.parametrize("request_, code", [
     ("{", "bad_json"), ({}, "bad_request"), ({"sun": 3}, "bad_request"), ({"sun_angle": 999}, "bad_request"),
     ({"doors": {"Door_42": "open"}}, "unknown_id"), ({"lights": {"Light_0": "dim"}}, "bad_request"),

@@ -41,13 +41,13 @@ def test_resolved_settings_cannot_be_changed(houses):
     settings = resolved(houses[15])
     door = next(iter(settings.doors))
     with pytest.raises(dataclasses.FrozenInstanceError):
-        settings.sun_angle = 3.0                              # type: ignore[misc]
+        settings.sun_angle = 3.0
     with pytest.raises(TypeError):
-        settings.doors[door] = not settings.doors[door]       # type: ignore[index]
+        settings.doors[door] = not settings.doors[door]
     with pytest.raises(TypeError):
-        settings.paint["Bedroom_1"]["walls"] = "brick"        # type: ignore[index]
+        settings.paint["Bedroom_1"]["walls"] = "brick"
     with pytest.raises(AttributeError):
-        settings.agents.append(settings.agents[0])            # type: ignore[attr-defined]
+        settings.agents.append(settings.agents[0])
 
 
 def test_resolved_keeps_its_own_copy_and_round_trips():
@@ -66,11 +66,11 @@ def test_resolved_keeps_its_own_copy_and_round_trips():
 def test_the_state_is_read_only_for_readers(world):
     door = next(iter(world.state.doors))
     with pytest.raises(TypeError):
-        world.state.doors[door] = False                       # type: ignore[index]
+        world.state.doors[door] = False
     with pytest.raises(TypeError):
-        world.state.paint["Bedroom_1"]["walls"] = "brick"     # type: ignore[index]
+        world.state.paint["Bedroom_1"]["walls"] = "brick"
     with pytest.raises(AttributeError):
-        world.state.revision = 99                             # type: ignore[misc]
+        world.state.revision = 99
 
 
 def test_writing_an_item_the_world_lacks_is_refused(houses):

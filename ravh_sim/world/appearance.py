@@ -25,7 +25,6 @@ from ravh_msgs_py.query import UNKNOWN_ID, QueryError
 from ravh_sim.errors import UnknownNameError, UserError
 from ravh_sim.world import paints
 from ravh_sim.world.furniture import variant_count
-from ravh_sim.world.house import Light
 from ravh_sim.world.scene import World
 from ravh_sim.world.settings import Resolved, light_group, load_settings, resolve
 
@@ -113,9 +112,6 @@ class Appearance:
         chosen = self._lights_named(which)
         states = self._resolve({"lights": {"set": {lid: state for lid in chosen}}}, seed).lights
         self.state.write(lights={lid: states[lid] for lid in chosen})
-
-    def lights_on(self) -> list[Light]:
-        return [lt for lt in self.house.lights if self.state.lights.get(lt.id, False)]
 
     # ------------------------------------------------------------------ bodies
     def set_paint(self, room_id: str, surface: str, paint: str) -> None:

@@ -5,9 +5,9 @@ ceiling light on", "random paint", "door Door_2 closed"); :func:`resolve` turns 
 :class:`Resolved` value with one explicit choice per light, door, room and object. Every random choice
 comes from the single seed, drawn per item from a stream named after the item, so changing one item's
 setting never reshuffles the others, and the same seed and file always give the same world.
-The resolved settings are frozen: a World starts from them and keeps what changes later in its own
-live state (:mod:`ravh_sim.world.state`), whose snapshot, again a :class:`Resolved`, goes into the
-footprint; a footprint rebuilds the world from it alone.
+The resolved settings are frozen: a World starts from them, and its live state
+(:mod:`ravh_sim.world.state`) is the current :class:`Resolved` value, replaced on each change. That
+value goes into the footprint, and a footprint rebuilds the world from it alone.
 """
 from __future__ import annotations
 
@@ -173,9 +173,8 @@ class Resolved:
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Resolved:
         agents = tuple(AgentSpec(a["name"], a["profile"], _pose(a["pose"])) for a in d.get("agents", []))
-        return cls(seed=int(d["seed"]), sun_angle=float(d["sun_angle"]), lights=dict(d["lights"]),
-                   doors=dict(d["doors"]), paint={k: dict(v) for k, v in d["paint"].items()},
-                   models={k: int(v) for k, v in d["models"].items()}, agents=agents)
+        return cls(seed=int(d["seed"]), sun_angle=float(d["sun_angle"]), lights=d["lights"], doors=d["doors"],
+                   paint=d["paint"], models={k: int(v) for k, v in d["models"].items()}, agents=agents)
 
 
 def _pose(values: Any) -> tuple[float, float, float]:
