@@ -19,10 +19,12 @@ from typing import Any
 from ravh_msgs_py.query import BAD_REQUEST, QueryError, decode
 
 KEYS = ("sun_angle", "lights", "doors", "paint", "models", "seed", "randomise")
-SUN_WORDS = ("day", "sunset", "night", "random")
+# The one vocabulary of appearance: requests, settings files, the CLI and the simulator use these names.
+SUN_PRESETS = {"day": 100.0, "sunset": 180.0, "night": 200.0}      # sun angle in degrees of each word
+SUN_WORDS = (*SUN_PRESETS, "random")
 SWITCH = ("on", "off", "random")
 DOOR = ("open", "closed", "random")
-LIGHT_GROUPS = ("all", "ceiling", "lamps")
+LIGHT_GROUPS = ("all", "ceiling", "lamps")   # lamps: every light that is not a ceiling light
 SURFACES = ("walls", "floor")
 SEED_MAX = 2**32 - 1       # the one seed range: settings files, command-line flags and requests
 

@@ -137,7 +137,7 @@ def bench_nav(houses: list[int] | None = None) -> dict[str, Any]:
         empty_step_s = _timed(lambda: empty.step(STEP_SAMPLES))[0] / STEP_SAMPLES
         sim = Simulation(world)
         robot = next(iter(sim.robots.values()))
-        navigation = Navigation(house, world.settings, robot.profile)
+        navigation = Navigation(house, world.state, robot.profile)
         grid = navigation.map()
         start, goal = robot.pose[:2], _farthest_goal(navigation, robot.pose[:2])
         plan_s, path = _best_of(3, lambda: plan_path(grid, start, goal, house=house))

@@ -15,6 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from ravh_msgs_py.appearance import DOOR, SWITCH
 from ravh_sim.bench import BENCHES
 from ravh_sim.dataset.build import add_parser as add_dataset_parser
 from ravh_sim.errors import UserError
@@ -124,13 +125,15 @@ def cmd_map(args: argparse.Namespace) -> int:
     from ravh_sim.robot.profile import load_profile
     from ravh_sim.world.house import load_house
     from ravh_sim.world.settings import load_settings, resolve
+    from ravh_sim.world.state import WorldState
     house = load_house(args.house)
     settings = load_settings(args.config)
     if args.doors:
         settings["doors"] = {"all": args.doors, "set": {}}
     resolved = resolve(settings, house, args.seed, str(args.config or "config/default.yaml"))
     profile = load_profile(args.profile or (resolved.agents[0].profile if resolved.agents else "giraff"))
-    pgm, yaml_path = Navigation(house, resolved, profile, args.resolution).write_map(args.output, args.inflated)
+    navigation = Navigation(house, WorldState(resolved), profile, args.resolution)
+    pgm, yaml_path = navigation.write_map(args.output, args.inflated)
     print(f"wrote {pgm} and {yaml_path}")
     return 0
 
@@ -152,8 +155,9 @@ def cmd_footprint(args: argparse.Namespace) -> int:
 
 def cmd_query(args: argparse.Namespace) -> int:
     from ravh_sim.world.ground_truth import GroundTruth
+    from ravh_sim.world.state import WorldState
     house, resolved = _resolved(args)
-    reply = GroundTruth(house, resolved).answer(args.request)
+    reply = GroundTruth(house, WorldState(resolved)).answer(args.request)
     _print_json(reply)
     return 0 if reply["ok"] else 1
 
@@ -254,7 +258,7 @@ def _parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("map", help="write the house's obstacle map, as the sim's /map (ROS map_server PGM + YAML)")
     _world_args(p)
-    p.add_argument("--doors", choices=("open", "closed", "random", "default"), default=None,
+    p.add_argument("--doors", choices=(*DOOR, "default"), default=None,
                    help="every door's state (default: as the config says)")
     p.add_argument("--resolution", type=_positive, default=0.05, help="metres per cell (default 0.05)")
     p.add_argument("--profile", default=None, help="robot profile (default: the first agent's)")
@@ -278,7 +282,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--pose", type=float, nargs=3, metavar=("X", "Y", "YAW"), required=True,
                    help="robot pose on the floor (m, m, rad)")
     p.add_argument("--sun", default=None, help="sun angle in degrees, or day, sunset, night (default: config)")
-    p.add_argument("--lights", choices=("on", "off", "random"), default=None,
+    p.add_argument("--lights", choices=SWITCH, default=None,
                    help="switch every light (default: config); random uses --seed")
     p.add_argument("--renderer", choices=BACKENDS, default="auto")
     p.add_argument("--profile", default="giraff", help="robot profile for the camera (default: giraff)")

@@ -8,7 +8,6 @@ node only converts and publishes.
 """
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,7 +32,7 @@ from ravh_sim.world.footprint import load_footprint, make_footprint
 from ravh_sim.world.ground_truth import GroundTruth
 from ravh_sim.world.house import House, load_house
 from ravh_sim.world.scene import World
-from ravh_sim.world.settings import Resolved, load_settings, resolve
+from ravh_sim.world.settings import load_settings, resolve
 
 # camera_link (x forward, z up) -> optical frame (z forward, x right, y down), REP 103
 OPTICAL_ROTATION = quaternion_from_matrix(LINK_TO_OPTICAL)
@@ -72,15 +71,13 @@ class SimRuntime:
                  footprint: str | Path | None = None) -> None:
         """``footprint``: rebuild exactly the world a footprint file describes (its house and its
         resolved settings); ``house``, ``config`` and ``seed`` are then ignored."""
-        self.config_source = str(config or "config/default.yaml")
-        self.settings_doc = load_settings(config)
         if footprint:
             number, resolved = load_footprint(Path(footprint))
             self.house = load_house(number)
         else:
             self.house = house if isinstance(house, House) else load_house(house)
-            resolved = resolve(self.settings_doc, self.house, seed, self.config_source)
-        self.initial = Resolved.from_dict(resolved.to_dict())
+            resolved = resolve(load_settings(config), self.house, seed, str(config or "config/default.yaml"))
+        self.initial = resolved
         self.world = World(self.house, resolved, renderer=renderer)
         self.appearance = Appearance(self.world)
         self.sim = Simulation(self.world)
@@ -93,11 +90,14 @@ class SimRuntime:
                                      SmartCamera(self.world, profile.camera,
                                                  CameraOptions(**dict(profile.camera_effects))),
                                      Laser(self.world, profile.laser), i == 0))
-        self.navigation = Navigation(self.house, self.world.settings, self.agents[0].profile
+        self.navigation = Navigation(self.house, self.world.state, self.agents[0].profile
                                      if self.agents else load_profile("giraff"))
-        self.ground_truth = GroundTruth(self.house, self.world.settings)   # reads the live settings
-        self.map_version = 0
-        self._map_state = self._door_model_state()
+        self.ground_truth = GroundTruth(self.house, self.world.state)
+
+    @property
+    def map_version(self) -> int:
+        """Changes when a door or an object model changed (the node republishes /map)."""
+        return self.world.state.layout_revision
 
     # ------------------------------------------------------------------ time
     @property
@@ -175,7 +175,6 @@ class SimRuntime:
         for spec, agent in zip(self.initial.agents, self.agents):
             agent.robot.set_command(0.0, 0.0)
             agent.robot.teleport(*spec.pose)
-        self._check_map()
 
     # ------------------------------------------------------------------ JSON services
     def query(self, text: str) -> dict[str, Any]:
@@ -184,10 +183,7 @@ class SimRuntime:
     def change_appearance(self, text: str | dict) -> dict[str, Any]:
         """Apply an appearance request (ravh_msgs_py.appearance); never raises."""
         try:
-            request = appearance_lang.parse(text)
-            changed = self._apply_appearance(request)
-            self._check_map()
-            return ok_reply(changed)
+            return ok_reply(self.appearance.change(appearance_lang.parse(text)))
         except QueryError as e:
             return e.reply()
         except UserError as e:
@@ -195,86 +191,9 @@ class SimRuntime:
         except Exception as e:  # a request must never take the node down
             return error_reply(INTERNAL, f"{type(e).__name__}: {e}")
 
-    def _apply_appearance(self, req: dict[str, Any]) -> dict[str, Any]:
-        """Turn the request into settings overrides, resolve them like a settings file (same seed
-        rules), and apply only the items the request names."""
-        if "randomise" in req:
-            return {"settings": self.appearance.randomise(int(req["randomise"])).to_dict()}
-        self._check_names(req)
-        doc = json.loads(json.dumps(self.settings_doc))
-        doc["lights"]["set"], doc["doors"]["set"], doc["paint"]["rooms"], doc["models"]["set"] = {}, {}, {}, {}
-        target = Resolved.from_dict(self.world.settings.to_dict())
-        if "sun_angle" in req:
-            doc["lights"]["sun_angle"] = req["sun_angle"]
-        for which, state in req.get("lights", {}).items():
-            for light in self._lights_named(which):
-                doc["lights"]["set"][light] = state
-        for door, state in req.get("doors", {}).items():
-            for d in (self.house.door_by_id if door == "all" else [door]):
-                doc["doors"]["set"][d] = {True: "open", False: "closed"}.get(state, state)
-        for room, surfaces in req.get("paint", {}).items():
-            for r in (self.house.room_by_id if room == "all" else [room]):
-                doc["paint"]["rooms"][r] = dict(surfaces)
-        inherit = {}
-        for obj, model in req.get("models", {}).items():
-            for o in (self.house.object_by_id if obj == "all" else [obj]):
-                if isinstance(model, dict):
-                    inherit[o] = self.house.object(model["inherit"]).id
-                else:
-                    doc["models"]["set"][o] = model
-        seed = req.get("seed", self.world.settings.seed)
-        picked = resolve(doc, self.house, seed, "appearance request")
-        if "sun_angle" in req:
-            target.sun_angle = picked.sun_angle
-        for section in ("lights", "doors", "models"):
-            chosen = getattr(picked, section)
-            for item in doc[section]["set"]:
-                getattr(target, section)[item] = chosen[item]
-        for room, surfaces in doc["paint"]["rooms"].items():
-            for surface in surfaces:
-                target.paint[room][surface] = picked.paint[room][surface]
-        for obj, source in inherit.items():
-            target.models[obj] = target.models[source]
-        self.appearance.apply(target)
-        return {"settings": self.world.settings.to_dict()}
-
-    def _lights_named(self, which: str) -> list[str]:
-        kinds = {"all": ("ceiling", "lamp", "wall"), "ceiling": ("ceiling",), "lamps": ("lamp", "wall")}
-        if which in kinds:
-            return [lt.id for lt in self.house.lights if lt.kind in kinds[which]]
-        return [which]
-
-    def _check_names(self, req: dict[str, Any]) -> None:
-        h = self.house
-        for door in req.get("doors", {}):
-            if door != "all" and door not in h.door_by_id:
-                raise QueryError("unknown_id", f"unknown door {door!r}", ["all", *h.door_by_id])
-        for light in req.get("lights", {}):
-            if light not in ("all", "ceiling", "lamps") and light not in h.light_by_id:
-                raise QueryError("unknown_id", f"unknown light {light!r}", ["all", "ceiling", "lamps",
-                                                                              *h.light_by_id])
-        for room in req.get("paint", {}):
-            if room != "all" and room not in h.room_by_id:
-                raise QueryError("unknown_id", f"unknown room {room!r}", ["all", *h.room_by_id])
-        for obj in req.get("models", {}):
-            if obj != "all" and obj not in h.object_by_id:
-                raise QueryError("unknown_id", f"unknown object {obj!r}", ["all", *h.object_by_id])
-
-    # ------------------------------------------------------------------ map and footprint
-    def _door_model_state(self) -> str:
-        return json.dumps([self.world.settings.doors, self.world.settings.models], sort_keys=True)
-
-    def _check_map(self) -> bool:
-        """Bump the map version when doors or models changed (the node republishes /map)."""
-        state = self._door_model_state()
-        if state != self._map_state:
-            self._map_state = state
-            self.map_version += 1
-            return True
-        return False
-
     def footprint(self) -> dict[str, Any]:
-        return make_footprint(self.house, self.world.settings)
+        """The footprint of the world as the sensors see it now."""
+        return make_footprint(self.house, self.world.state.settings())
 
     def close(self) -> None:
         for agent in self.agents:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -30,8 +31,7 @@ def test_laser_and_depth_agree_on_walls_objects_and_doors(houses, number):
     leaves 40 mm). Poses: the station and four headings at each room centre, all doors closed."""
     house = houses[number]
     settings = resolve(load_settings(), house)
-    settings.doors = {door: False for door in settings.doors}
-    with World(house, settings) as world:
+    with World(house, replace(settings, doors=dict.fromkeys(settings.doors, False))) as world:
         camera, laser = SmartCamera(world, PROFILE.camera), Laser(world, PROFILE.laser)
         poses = [(house.station.position[0], house.station.position[1], house.station.yaw)]
         for room in house.rooms:
@@ -55,8 +55,8 @@ def test_no_cracks_around_doors(houses, number):
     or the ceiling lets the sky or the ground show (1 in 6 of these captures did)."""
     house = houses[number]
     settings = resolve(load_settings(), house)
-    settings.doors = {d.id: settings.doors[d.id] and len(d.rooms) == 2 for d in house.doors}
-    with World(house, settings) as world:
+    doors = {d.id: settings.doors[d.id] and len(d.rooms) == 2 for d in house.doors}
+    with World(house, replace(settings, doors=doors)) as world:
         camera = SmartCamera(world, PROFILE.camera)
         captures = 0
         for door in house.doors:

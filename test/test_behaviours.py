@@ -16,6 +16,7 @@ from ravh_sim.nav.grid import FREE, reachable
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.robot.simulation import Simulation
 from ravh_sim.world.scene import World
+from ravh_sim.world.state import WorldState
 
 CONTROL_STEPS = 12          # 20 Hz control at 240 Hz physics
 
@@ -27,7 +28,7 @@ def rig(houses):
         world = World(house, resolved(house), renderer="tiny")
         sim = Simulation(world)
         robot = sim.robot("robot")
-        nav = Navigation(house, world.settings, robot.profile)
+        nav = Navigation(house, world.state, robot.profile)
         return house, world, sim, robot, nav, PathFollower(robot, nav, robot.profile)
     made = []
     yield lambda n: made.append(make(n)) or made[-1]
@@ -48,7 +49,7 @@ def run(sim, behaviour, robot, limit_s: float):
 def test_light_waypoints_lie_in_free_space_in_their_room(houses):
     for n in (1, 15, 23):
         house = houses[n]
-        nav = Navigation(house, resolved(house), _profile())
+        nav = Navigation(house, WorldState(resolved(house)), _profile())
         grid = nav.map()
         start = house.station.position[:2]
         waypoints = light_waypoints(Layout.of(house), grid, start)
@@ -77,7 +78,7 @@ def test_wanderer_visits_every_room_and_captures_while_moving(rig):
 
 def test_grid_nodes_cover_the_free_area_at_the_spacing(houses):
     house = houses[20]
-    grid = Navigation(house, resolved(house), _profile()).map()
+    grid = Navigation(house, WorldState(resolved(house)), _profile()).map()
     start = house.station.position[:2]
     nodes = grid_nodes(Layout.of(house), grid, start, spacing=0.5)
     pts = np.array(nodes)

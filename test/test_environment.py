@@ -2,10 +2,12 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import pytest
 from conftest import resolved
 
+from ravh_msgs_py.appearance import SUN_PRESETS
 from ravh_sim.errors import FileFieldError
 from ravh_sim.world.footprint import (
     build_instances,
@@ -16,7 +18,8 @@ from ravh_sim.world.footprint import (
     write_footprint,
 )
 from ravh_sim.world.ground_truth import GroundTruth
-from ravh_sim.world.settings import SUN_PRESETS, load_settings, resolve
+from ravh_sim.world.settings import load_settings, resolve
+from ravh_sim.world.state import WorldState
 
 
 def _settings(tmp_path, text: str) -> dict:
@@ -113,7 +116,7 @@ def test_unknown_door_error_lists_valid_doors(houses, tmp_path):
 
 @pytest.fixture(scope="module")
 def gt15(houses):
-    return GroundTruth(houses[15], resolved(houses[15]))
+    return GroundTruth(houses[15], WorldState(resolved(houses[15])))
 
 
 def test_objects_in_room_match_house(gt15, houses):
@@ -142,9 +145,8 @@ def test_room_at_points_inside_each_room(gt15, houses):
 
 def test_connectivity_joins_every_room_with_doors_open(houses):
     for n in (15, 20, 23):
-        gt = GroundTruth(houses[n], resolved(houses[n]))
-        settings_open = gt.settings
-        settings_open.doors = {d: True for d in settings_open.doors}
+        settings = resolved(houses[n])
+        gt = GroundTruth(houses[n], WorldState(replace(settings, doors=dict.fromkeys(settings.doors, True))))
         comps = gt.answer({"query": "connectivity"})["result"]["components"]
         assert len(comps) == 1, (n, comps)
 
@@ -184,8 +186,8 @@ def test_instances_are_in_fixed_order(houses):
 
 
 def test_closing_every_door_splits_the_connectivity_graph(houses):
-    gt = GroundTruth(houses[15], resolved(houses[15]))
-    gt.settings.doors = {d: False for d in gt.settings.doors}
+    settings = resolved(houses[15])
+    gt = GroundTruth(houses[15], WorldState(replace(settings, doors=dict.fromkeys(settings.doors, False))))
     comps = gt.answer({"query": "connectivity", "open_only": True})["result"]["components"]
     assert len(comps) == len(houses[15].rooms)        # house 15 has no door-less passages
 

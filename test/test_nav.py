@@ -499,17 +499,41 @@ def test_unreachable_names_only_the_doors_that_cut_the_way(houses):
     from ravh_sim.nav.navigation import Navigation
     from ravh_sim.robot.profile import load_profile
     from ravh_sim.world.settings import load_settings, resolve
+    from ravh_sim.world.state import WorldState
     house = houses[20]
     settings = resolve(load_settings(), house, 0)
-    settings.doors.update(Door_1=False, Door_2=False)           # Door_2 is the bathroom's, not on the way
-    nav = Navigation(house, settings, load_profile("giraff"))
+    doors = {**settings.doors, "Door_1": False, "Door_2": False}   # Door_2 is the bathroom's, not on the way
+    nav = Navigation(house, WorldState(dataclasses.replace(settings, doors=doors)), load_profile("giraff"))
     goal = nav.room_goal("Bedroom_1")
     with pytest.raises(Unreachable) as err:
         nav.plan(house.station.position[:2], goal)
     assert "closed doors: Door_1)" in str(err.value)
     house23 = houses[23]
-    nav23 = Navigation(house23, resolve(load_settings(), house23, 0), load_profile("giraff"))
+    nav23 = Navigation(house23, WorldState(resolve(load_settings(), house23, 0)), load_profile("giraff"))
     grid = nav23.map()
     r, c = np.argwhere(grid.polygons_mask((house23.room("UtilityRoom_1").floor,)) & (grid.data == FREE))[0]
     with pytest.raises(Unreachable, match=r"blocked \(walls or furniture\)"):
         nav23.plan(house23.station.position[:2], grid.center_of(r, c))
+
+
+def test_navigation_rebuilds_its_maps_only_when_the_layout_changes(houses):
+    """The maps are cached on the state's layout revision: paint or light changes keep them, a door
+    that closes gives new ones that block its doorway."""
+    from ravh_sim.nav.navigation import Navigation
+    from ravh_sim.robot.profile import load_profile
+    from ravh_sim.world.settings import load_settings, resolve
+    from ravh_sim.world.state import WorldState
+    house = houses[15]
+    settings = resolve(load_settings(), house, 0)
+    state = WorldState(dataclasses.replace(settings, doors=dict.fromkeys(settings.doors, True)))
+    nav = Navigation(house, state, load_profile("giraff"))
+    free, obstacle = nav.map(), nav.obstacle_map()
+    state.write(sun_angle=200.0, paint={"Bedroom_1": {"walls": "brick"}})
+    assert nav.map() is free and nav.obstacle_map() is obstacle
+    door = next(d for d in house.doors if len(d.rooms) == 2)
+    state.write(doors={door.id: False})
+    closed = nav.map()
+    assert closed is not free and nav.obstacle_map() is not obstacle
+    r, c = closed.cell_of(*door.position[:2])
+    assert free.data[r, c] == FREE and closed.data[r, c] != FREE
+    assert nav.map() is closed

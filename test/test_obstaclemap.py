@@ -12,6 +12,7 @@ from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.nav.obstaclemap import LASER_PLANE_MARGIN
 from ravh_sim.robot.profile import load_profile
+from ravh_sim.world.state import WorldState
 
 
 def shoelace(polygon) -> float:
@@ -37,7 +38,7 @@ def test_free_area_is_the_floor_less_what_stands_on_it(houses, number):
     house = houses[number]
     settings = resolved(house)
     profile = load_profile("giraff")
-    nav = Navigation(house, settings, profile)
+    nav = Navigation(house, WorldState(settings), profile)
     grid = nav.obstacle_map()
     cell = grid.resolution ** 2
     free = (grid.data == FREE).sum() * cell
@@ -51,7 +52,7 @@ def test_free_area_is_the_floor_less_what_stands_on_it(houses, number):
 def test_obstacle_map_is_not_inflated(houses):
     """Right next to a wall the obstacle map is free; the robot's free space keeps its radius off it."""
     house = houses[20]
-    nav = Navigation(house, resolved(house), load_profile("giraff"))
+    nav = Navigation(house, WorldState(resolved(house)), load_profile("giraff"))
     obstacles, free_space = nav.obstacle_map(), nav.map()
     occupied = (obstacles.data == OCCUPIED).astype(np.uint8)
     ring = (cv2.dilate(occupied, np.ones((3, 3), np.uint8)) > 0) & (obstacles.data == FREE)

@@ -32,7 +32,7 @@ def world():
 @pytest.fixture()
 def appearance(world):
     app = Appearance(world)
-    before = replace(world.settings)
+    before = world.state.settings()
     yield app
     app.apply(before)
 

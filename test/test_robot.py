@@ -25,6 +25,7 @@ from ravh_sim.poses import relative, wrap_angle
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.robot.robot import Odometry, Robot
 from ravh_sim.robot.simulation import Simulation
+from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.scene import World
 from ravh_sim.world.settings import AgentSpec, resolve
@@ -47,7 +48,7 @@ def make_world(houses, default_settings):
         house = houses[number]
         settings = resolve(default_settings, house)
         if agents is not None:
-            settings.agents = agents
+            settings = dataclasses.replace(settings, agents=tuple(agents))
         world = World(house, settings, renderer="tiny")
         made.append(world)
         return world
@@ -94,12 +95,12 @@ def part_rects(world: World, obj_id: str) -> list[Rect]:
     floor = world.house.room(obj.room).floor_z
     if obj_id in world.house.door_by_id:
         floor = min(world.house.room(r).floor_z for r in world.house.door_by_id[obj_id].rooms)
-    placed = object_parts(world.house, obj, world.settings.models[obj_id])
+    placed = object_parts(world.house, obj, world.state.models[obj_id])
     return list(placed.footprints(floor + 0.02, floor + GIRAFF.height))
 
 
 def object_rect(world, obj) -> Rect:
-    box = obj.box(world.settings.models[obj.id])
+    box = obj.box(world.state.models[obj.id])
     return box.position[:2], box.size[:2], obj.yaw
 
 
@@ -136,7 +137,7 @@ def ram(world: World, pose, seconds: float, watch: list[Rect]) -> tuple[list[flo
 def test_full_speed_into_a_wall_stops_at_the_wall(make_world, angle_deg):
     world = make_world(15)
     walls = wall_rects(world.house)
-    nav = Navigation(world.house, world.settings, GIRAFF)
+    nav = Navigation(world.house, world.state, GIRAFF)
     room = world.house.room("KitchenLivingRoom_1")
     goal = nav.room_goal(room.id)
     _, wall, (pose, (nx, ny)) = min(((rect_distance(goal, w), w, a) for w in walls
@@ -152,17 +153,17 @@ def test_full_speed_into_a_wall_stops_at_the_wall(make_world, angle_deg):
 
 def test_full_speed_into_a_closed_door_stops_at_the_leaf(make_world):
     world = make_world(15)
-    nav = Navigation(world.house, world.settings, GIRAFF)
+    nav = Navigation(world.house, world.state, GIRAFF)
     open_map = nav.map()                                        # doorways free: a clear run up to them
     for door in world.house.doors:
-        if world.settings.doors[door.id] and len(door.rooms) == 2:
+        if world.state.doors[door.id] and len(door.rooms) == 2:
             leaf = door_leaf_rect(door)
             found = next(approaches(open_map, leaf), None)
             if found:
                 break
     assert found, "no open door in house 15 with a clear approach"
     pose, (nx, ny) = found
-    world.set_door_open(door.id, False)
+    Appearance(world).set_door(door.id, False)
     distances, robot = ram(world, pose, seconds=1.0 / VMAX + 4.0,
                            watch=[*part_rects(world, door.id), *wall_rects(world.house)])
     assert min(distances) >= R - SINK
@@ -174,7 +175,7 @@ def test_full_speed_into_a_closed_door_stops_at_the_leaf(make_world):
 @pytest.mark.parametrize("kind", ["Bed", "Closet", "Chair", "Refrigerator"])
 def test_full_speed_into_furniture_stops_at_it(make_world, kind):
     world = make_world(15)
-    nav = Navigation(world.house, world.settings, GIRAFF)
+    nav = Navigation(world.house, world.state, GIRAFF)
     for obj in world.house.objects:
         if obj.type == kind:
             rect = object_rect(world, obj)
@@ -202,9 +203,9 @@ def test_a_start_overlapping_a_wall_is_pushed_out_and_stays_put(make_world):
     assert math.dist(start[:2], station) < 0.15
     sim.step(240)
     assert math.dist(robot.pose[:2], start[:2]) < 1e-3
-    recorded = world.settings.agents[0].pose                   # the footprint says where it started
+    recorded = world.state.agents[0].pose                      # the footprint says where it started
     assert recorded[:2] == pytest.approx(start[:2], abs=1e-4) and recorded[:2] != pytest.approx(station)
-    assert make_footprint(world.house, world.settings)["settings"]["agents"][0]["pose"] == list(recorded)
+    assert make_footprint(world.house, world.state.settings())["settings"]["agents"][0]["pose"] == list(recorded)
 
 
 def test_a_start_inside_furniture_is_refused_naming_the_nearest_free_pose(make_world):
@@ -220,7 +221,7 @@ def test_a_start_inside_furniture_is_refused_naming_the_nearest_free_pose(make_w
     sim = Simulation(world)
     robot = sim.robot("robot")
     assert math.dist(suggested[:2], asked[:2]) < 1.0                # the bathroom is cramped
-    assert robot.is_clear() and world.settings.agents[0].pose == suggested
+    assert robot.is_clear() and world.state.agents[0].pose == suggested
     sim.step(240)
     assert math.dist(robot.pose[:2], suggested[:2]) < 1e-3
 
@@ -521,7 +522,7 @@ def test_follower_drives_from_the_station_to_the_farthest_room(make_world, numbe
     world = make_world(number)
     sim = Simulation(world)
     robot = sim.robot("robot")
-    nav = Navigation(world.house, world.settings, robot.profile)
+    nav = Navigation(world.house, world.state, robot.profile)
     goal, length = far_goal(nav, robot.pose[:2])
     assert length > 4.0
     follower = PathFollower(robot, nav, robot.profile)
@@ -537,7 +538,7 @@ def test_drive_helper_runs_the_loop(make_world):
     world = make_world(20)
     sim = Simulation(world)
     robot = sim.robot("robot")
-    nav = Navigation(world.house, world.settings, robot.profile)
+    nav = Navigation(world.house, world.state, robot.profile)
     follower = PathFollower(robot, nav, robot.profile)
     follower.navigate_to(nav.room_goal("Bedroom_1", robot.pose[:2]))
     assert drive(sim, follower, timeout=2.0) is Status.ACTIVE and sim.time == pytest.approx(2.0, abs=0.06)
@@ -548,19 +549,19 @@ def test_closing_the_only_door_makes_a_room_unreachable(make_world):
     world = make_world(20)
     sim = Simulation(world)
     robot = sim.robot("robot")
-    nav = Navigation(world.house, world.settings, robot.profile)
+    nav = Navigation(world.house, world.state, robot.profile)
     goal = nav.room_goal("Bedroom_1", robot.pose[:2])
     before = nav.map()
     assert nav.map() is before                                  # unchanged doors: no rebuild
     nav.plan(robot.pose[:2], goal)
-    world.set_door_open("Door_1", False)
+    Appearance(world).set_door("Door_1", False)
     assert nav.map() is not before
     with pytest.raises(Unreachable, match=r"in room Bedroom_1 is not reachable .*closed doors: .*Door_1"):
         nav.plan(robot.pose[:2], goal)
     follower = PathFollower(robot, nav, robot.profile)
     with pytest.raises(Unreachable, match="Door_1"):
         follower.navigate_to(goal)
-    world.set_door_open("Door_1", True)
+    Appearance(world).set_door("Door_1", True)
     assert nav.plan(robot.pose[:2], goal).length > 0
 
 
@@ -569,7 +570,7 @@ def test_follower_replans_around_a_door_closed_on_its_way(make_world):
     world = make_world(27)
     sim = Simulation(world)
     robot = sim.robot("robot")
-    nav = Navigation(world.house, world.settings, robot.profile)
+    nav = Navigation(world.house, world.state, robot.profile)
     door = world.house.door_by_id["Door_4"]
     goal = nav.room_goal("Corridor_1", robot.pose[:2])
     follower = PathFollower(robot, nav, robot.profile)
@@ -580,12 +581,12 @@ def test_follower_replans_around_a_door_closed_on_its_way(make_world):
     touched = []
 
     def close_door_half_way() -> None:
-        if world.settings.doors["Door_4"] and follower.remaining < first.length - 4.0:
-            world.set_door_open("Door_4", False)
+        if world.state.doors["Door_4"] and follower.remaining < first.length - 4.0:
+            Appearance(world).set_door("Door_4", False)
         touched.extend(pb.getContactPoints(robot.body, leaf, physicsClientId=world.client))
 
     statuses = follow_in_sim(sim, follower, 200.0, close_door_half_way)
-    assert not world.settings.doors["Door_4"]
+    assert not world.state.doors["Door_4"]
     assert Status.BLOCKED in statuses and follower.recoveries == 1
     assert "map changed" in follower.reason
     assert statuses[-1] is Status.ARRIVED, follower.reason
@@ -597,7 +598,7 @@ def test_follower_fails_with_a_reason_when_the_only_door_closes_on_its_way(make_
     world = make_world(20)
     sim = Simulation(world)
     robot = sim.robot("robot")
-    nav = Navigation(world.house, world.settings, robot.profile)
+    nav = Navigation(world.house, world.state, robot.profile)
     follower = PathFollower(robot, nav, robot.profile)
     first = follower.navigate_to(nav.room_goal("Bedroom_1", robot.pose[:2]))
 
@@ -605,8 +606,8 @@ def test_follower_fails_with_a_reason_when_the_only_door_closes_on_its_way(make_
     touched = []
 
     def close_door() -> None:
-        if world.settings.doors["Door_1"] and follower.remaining < first.length - 1.0:
-            world.set_door_open("Door_1", False)
+        if world.state.doors["Door_1"] and follower.remaining < first.length - 1.0:
+            Appearance(world).set_door("Door_1", False)
         touched.extend(pb.getContactPoints(robot.body, leaf, physicsClientId=world.client))
 
     statuses = follow_in_sim(sim, follower, 60.0, close_door)
@@ -617,7 +618,7 @@ def test_follower_fails_with_a_reason_when_the_only_door_closes_on_its_way(make_
 
 def test_map_files_match_the_navigation_map(make_world, tmp_path):
     world = make_world(20)
-    nav = Navigation(world.house, world.settings, GIRAFF)
+    nav = Navigation(world.house, world.state, GIRAFF)
     nav.write_map(tmp_path / "obstacles")
     nav.write_map(tmp_path / "free", inflated=True)
     for folder, grid in (("obstacles", nav.obstacle_map()), ("free", nav.map())):
@@ -649,7 +650,7 @@ def test_follower_gives_up_on_a_robot_standing_in_the_only_doorway(make_world):
     sim = Simulation(world, [AgentSpec("robot", "giraff", (*station.position[:2], station.yaw)),
                              AgentSpec("blocker", "giraff", (*door.position[:2], door.yaw))])
     robot, blocker = sim.robot("robot"), sim.robot("blocker")
-    nav = Navigation(world.house, world.settings, robot.profile)
+    nav = Navigation(world.house, world.state, robot.profile)
     follower = PathFollower(robot, nav, robot.profile)
     follower.navigate_to(nav.room_goal("Bedroom_1", robot.pose[:2]))
     statuses = follow_in_sim(sim, follower, 120.0)

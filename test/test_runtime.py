@@ -67,16 +67,29 @@ def test_optical_frame_rotation_is_rep103():
 
 
 def test_appearance_requests_change_only_what_they_name(runtime):
-    before = runtime.world.settings.to_dict()
+    before = runtime.world.state.settings().to_dict()
     reply = runtime.change_appearance({"doors": {"Door_1": "closed"}, "lights": {"ceiling": "off"}})
     assert reply["ok"], reply
-    after = runtime.world.settings
+    after = runtime.world.state
     assert after.doors["Door_1"] is False and not any(after.lights[lt.id] for lt in runtime.house.lights
                                                        if lt.kind == "ceiling")
     assert after.paint == before["paint"] and after.models == before["models"]
     assert runtime.map_version >= 1
     runtime.reset()
-    assert runtime.world.settings.to_dict() == runtime.initial.to_dict()
+    assert runtime.world.state.settings().to_dict() == runtime.initial.to_dict()
+
+
+def test_the_map_version_moves_with_doors_and_models_only(runtime):
+    """The node republishes /map when the map version moves: not for paint, sun or lights."""
+    before = runtime.map_version
+    reply = runtime.change_appearance({"paint": {"all": {"walls": "brick"}}, "sun_angle": "night",
+                                       "lights": {"all": "on"}})
+    assert reply["ok"], reply
+    assert runtime.map_version == before
+    is_open = runtime.world.state.doors["Door_1"]
+    assert runtime.change_appearance({"doors": {"Door_1": not is_open}})["ok"]
+    assert runtime.map_version > before
+    runtime.reset()
 
 
 @pytest.mark.parametrize("request_, code", [
@@ -85,10 +98,10 @@ def test_appearance_requests_change_only_what_they_name(runtime):
     ({"paint": {"Bedroom_1": {"walls": "plaid"}}}, "bad_request"), ({"models": {"Bed_0": 99}}, "bad_request"),
 ])
 def test_bad_appearance_requests_get_structured_errors(runtime, request_, code):
-    before = runtime.world.settings.to_dict()
+    before = runtime.world.state.settings().to_dict()
     reply = runtime.change_appearance(request_)
     assert reply["ok"] is False and reply["error"]["code"] == code
-    assert runtime.world.settings.to_dict() == before                 # nothing half-applied
+    assert runtime.world.state.settings().to_dict() == before                 # nothing half-applied
 
 
 def test_appearance_syntax_is_checked_offline():

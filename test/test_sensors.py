@@ -236,7 +236,7 @@ def test_camera_pose_is_the_pitched_optical_frame(camera):
 def test_instance_colours_use_the_footprint_mask_colours(camera, world, box_house):
     cap = camera.capture(6.8, 3.0, 0.0)
     colours = camera.instance_color(cap)
-    rows = {r["id"]: tuple(r["mask_color"]) for r in make_footprint(box_house, world.settings)["instances"]}
+    rows = {r["id"]: tuple(r["mask_color"]) for r in make_footprint(box_house, world.state.settings())["instances"]}
     v, u = 240, 320
     assert tuple(colours[v, u]) == rows[int(cap.instance[v, u])]
 
@@ -307,7 +307,7 @@ def _drive_and_scan(world: World, rooms: int, every_steps: int = 24):
     scanning every ``every_steps`` physics steps as the sim node does; (pose, scan) per scan."""
     sim = Simulation(world)
     robot = next(iter(sim.robots.values()))
-    laser, navigation = Laser(world, PROFILE.laser), Navigation(world.house, world.settings, PROFILE)
+    laser, navigation = Laser(world, PROFILE.laser), Navigation(world.house, world.state, PROFILE)
     follower, scans = PathFollower(robot, navigation, PROFILE), []
     for room in world.house.rooms[:rooms]:
         try:
@@ -345,7 +345,7 @@ def test_the_laser_sees_between_legs(houses):
     with World(house, resolve(load_settings(), house), renderer="tiny") as world:
         checked = 0
         for obj in house.objects:
-            box = obj.box(world.settings.models[obj.id])
+            box = obj.box(world.state.models[obj.id])
             if obj.type not in ("Table", "Chair") or box.size[2] < 0.6:     # no coffee tables
                 continue
             z = house.room(obj.room).floor_z + PROFILE.laser.height
@@ -381,7 +381,7 @@ def test_closing_a_door_changes_laser_and_depth_in_the_doorway(world, camera, ap
     assert closed_scan.ranges[180] == pytest.approx(leaf_x - pose[0], abs=0.003)  # the laser hits the leaf
     assert closed_cap.instance[240, 320] == door
     assert position[0] + open_cap.depth[240, 320] * along_x > 8.0            # into room B
-    assert world.settings.doors["Door_0"] is False
+    assert world.state.doors["Door_0"] is False
 
 
 # ----------------------------------------------------------------------------- appearance and lighting
@@ -429,7 +429,7 @@ def test_paint_changes_wall_pixel_colour(camera, world, appearance):
     r_warm, _, b_warm = warm.rgb[w].mean(axis=0)
     r_cool, _, b_cool = cool.rgb[w].mean(axis=0)
     assert r_warm > b_warm + 40 and b_cool > r_cool + 20
-    assert world.settings.paint["A"]["walls"] == "sky"
+    assert world.state.paint["A"]["walls"] == "sky"
     with pytest.raises(UserError):
         appearance.set_paint("A", "walls", "plaid")
 
@@ -442,8 +442,8 @@ def test_swapping_an_object_model_changes_its_pixels(camera, world, appearance):
     both = (before.instance == closet) & (after.instance == closet)
     diff = np.abs(before.rgb.astype(int) - after.rgb.astype(int)).sum(axis=2)
     assert both.mean() > 0.2 and (diff[both] > 20).mean() > 0.05
-    assert world.settings.models["Closet_0"] == 1
-    assert make_footprint(world.house, world.settings)["settings"]["models"]["Closet_0"] == 1
+    assert world.state.models["Closet_0"] == 1
+    assert make_footprint(world.house, world.state.settings())["settings"]["models"]["Closet_0"] == 1
 
 
 def test_model_choices_random_and_inherit(world, appearance):
@@ -460,10 +460,10 @@ def test_model_choices_random_and_inherit(world, appearance):
 def test_randomise_changes_settings_and_world_together(world, appearance):
     target = appearance.randomise(seed=3)
     again = resolve(load_settings(), world.house, 0)
-    assert target is world.settings
+    assert target == world.state.settings()
     assert target.paint != again.paint or target.models != again.models or target.lights != again.lights
     assert 0.0 <= target.sun_angle <= 240.0
-    fp = make_footprint(world.house, world.settings)
+    fp = make_footprint(world.house, world.state.settings())
     assert fp["settings"]["paint"] == target.paint
 
 

@@ -2,12 +2,14 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pybullet as pb
 import pytest
 from conftest import resolved
 
+from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import build_instances, make_footprint
 from ravh_sim.world.furniture import variant_count
 from ravh_sim.world.mesh import Mesh
@@ -54,8 +56,8 @@ def test_collision_boxes_fit_the_object_boxes(houses):
 def test_doors_open_and_close_at_run_time(houses):
     house = houses[15]
     with World(house, resolved(house), renderer="tiny") as world:
-        door = house.doors[0]
-        world.set_door_open(door.id, False)
+        door, appearance = house.doors[0], Appearance(world)
+        appearance.set_door(door.id, False)
         closed_z = world.object_pose(door.id)[0][2]
         nx, ny = -math.sin(door.yaw), math.cos(door.yaw)          # across the doorway
         x, y = door.position[:2]
@@ -65,10 +67,10 @@ def test_doors_open_and_close_at_run_time(houses):
                               physicsClientId=world.client)[0][0]
 
         assert ray_hit() == world.instance(door.id).body
-        world.set_door_open(door.id, True)
+        appearance.set_door(door.id, True)
         assert ray_hit() == -1
         assert world.object_pose(door.id)[0][2] < closed_z - 10
-        assert world.settings.doors[door.id] is True
+        assert world.state.doors[door.id] is True
 
 
 def test_model_swap_rebuilds_the_body(houses):
@@ -77,7 +79,7 @@ def test_model_swap_rebuilds_the_body(houses):
     with World(house, settings, renderer="tiny") as world:
         inst = world.instance("Bed_0")
         before = pb.getVisualShapeData(inst.body, physicsClientId=world.client)[0][4]
-        world.set_object_model("Bed_0", (settings.models["Bed_0"] + 1) % 3)
+        Appearance(world).set_object_model("Bed_0", (settings.models["Bed_0"] + 1) % 3)
         after = pb.getVisualShapeData(world.instance("Bed_0").body, physicsClientId=world.client)[0][4]
         assert before != after
         assert world.body_to_instance_lut()[world.instance("Bed_0").body] == inst.id
@@ -95,8 +97,8 @@ def test_every_variant_of_every_object_lies_in_its_footprint_box(houses):
     for n, house in houses.items():
         settings = resolved(house)
         for variant in range(max(variant_count(o.type) for o in house.objects)):
-            settings.models = {o.id: variant for o in house.objects}
-            rows = {r["name"]: r for r in make_footprint(house, settings)["instances"]}
+            models = {o.id: variant for o in house.objects}
+            rows = {r["name"]: r for r in make_footprint(house, replace(settings, models=models))["instances"]}
             for obj in house.objects:
                 row, placed = rows[obj.id], object_parts(house, obj, variant)
                 if obj.id in house.door_by_id:

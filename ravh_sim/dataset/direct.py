@@ -103,7 +103,7 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
         runtime = SimRuntime(house, settings_path, seed, renderer=renderer, rates=Rates(0.0, 0.0, 0.0, 0.0))
         try:
             meta = {"house": runtime.house.number, "engine": "direct", "behaviour": _describe(spec),
-                    "seed": runtime.world.settings.seed, **(raid or {})}
+                    "seed": runtime.world.state.seed, **(raid or {})}
             session = _Session(runtime, writer, progress)
             writer.write_meta(runtime.house.number, [session.agent.name], meta)
             writer.write_footprint(runtime.footprint())

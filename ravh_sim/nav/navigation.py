@@ -4,15 +4,15 @@ Two maps: :meth:`Navigation.map` is the robot's inflated free space (where its c
 the planner and behaviours use), :meth:`Navigation.obstacle_map` the uninflated obstacle map at laser
 height (what a ROS map_server would load: the sim's /map).
 
-It watches the settings a World changes at run time (doors, object models) rather than the World
-itself, so the same object serves the simulator (pass ``world.house, world.settings``: the World
-updates those settings in place) and tools that never start pybullet (``ravh map``). The map is
-rebuilt only when a door or a model differs from what it was built from.
+It reads a :class:`~ravh_sim.world.state.WorldState` rather than the World itself, so the same object
+serves the simulator (pass ``world.house, world.state``: the live state) and tools that never start
+pybullet (``ravh map``: ``WorldState(resolved)``). The maps are rebuilt only when the state's
+``layout_revision`` moved (a door or an object model changed), never by comparing doors and models.
 """
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path as FilePath
 
 import numpy as np
@@ -24,7 +24,7 @@ from ravh_sim.nav.obstaclemap import obstacle_map
 from ravh_sim.nav.planner import Path, Point, Unreachable, densify, plan_path
 from ravh_sim.robot.profile import RobotProfile
 from ravh_sim.world.house import House
-from ravh_sim.world.settings import Resolved
+from ravh_sim.world.state import WorldState
 
 DEFAULT_RESOLUTION = 0.05        # m per cell, as the ROS map_server maps the project writes
 START_SNAP = 0.3                 # m, as the planner: a start on the inflation uses the free cell nearby
@@ -33,10 +33,10 @@ START_SNAP = 0.3                 # m, as the planner: a start on the inflation u
 class Navigation:
     """Maps and planner for one robot profile (its radius, height and laser height shape the maps)."""
 
-    def __init__(self, house: House, settings: Resolved, profile: RobotProfile,
+    def __init__(self, house: House, state: WorldState, profile: RobotProfile,
                  resolution: float = DEFAULT_RESOLUTION) -> None:
-        self.house, self.settings, self.profile, self.resolution = house, settings, profile, resolution
-        self._built_from: tuple[dict[str, bool], dict[str, int]] | None = None
+        self.house, self.state, self.profile, self.resolution = house, state, profile, resolution
+        self._built_at = state.layout_revision
         self._grids: dict[str, Grid] = {}
 
     def map(self) -> Grid:
@@ -51,17 +51,16 @@ class Navigation:
         return self._current("obstacles", lambda doors, models: obstacle_map(
             self.house, doors, models, self.profile.laser.height, self.resolution))
 
-    def _current(self, kind: str, build: Callable[[dict, dict], Grid]) -> Grid:
-        """The cached grid of ``kind``, rebuilt when a door or a model changed since it was built."""
-        state = (dict(self.settings.doors), dict(self.settings.models))
-        if state != self._built_from:
-            self._grids, self._built_from = {}, state
+    def _current(self, kind: str, build: Callable[[Mapping[str, bool], Mapping[str, int]], Grid]) -> Grid:
+        """The cached grid of ``kind``, rebuilt when the layout revision moved since it was built."""
+        if self.state.layout_revision != self._built_at:
+            self._grids, self._built_at = {}, self.state.layout_revision
         if kind not in self._grids:
-            self._grids[kind] = build(*state)
+            self._grids[kind] = build(self.state.doors, self.state.models)
         return self._grids[kind]
 
     def closed_doors(self) -> list[str]:
-        return [door for door, is_open in self.settings.doors.items() if not is_open]
+        return [door for door, is_open in self.state.doors.items() if not is_open]
 
     def plan(self, start: Point, goal: Point) -> Path:
         """A path on the current map; raises :class:`~ravh_sim.nav.planner.Unreachable` naming the
@@ -77,7 +76,7 @@ class Navigation:
     def _why_unreachable(self, start: Point, goal: Point, closed: list[str]) -> Unreachable:
         """Name the closed doors that really cut the way: those on the path that would exist with every
         door open; if none would exist, walls or furniture are to blame, not the doors."""
-        open_all = free_space(self.house, {d: True for d in self.settings.doors}, self.settings.models,
+        open_all = free_space(self.house, dict.fromkeys(self.state.doors, True), self.state.models,
                               radius=self.profile.radius, height=self.profile.height, resolution=self.resolution)
         try:
             path = plan_path(open_all, start, goal)

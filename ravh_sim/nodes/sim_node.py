@@ -90,7 +90,7 @@ class SimNode(Node):
         rt = self.runtime
         self.get_logger().info(
             f"house {rt.house.number}: {len(rt.house.rooms)} rooms, {len(rt.house.objects)} objects, "
-            f"renderer {rt.world.renderer}, seed {rt.world.settings.seed}, real-time factor {self.rtf:g}")
+            f"renderer {rt.world.renderer}, seed {rt.world.state.seed}, real-time factor {self.rtf:g}")
         self.lockstep = bool(p["lockstep"])
         self._allowed, self._heartbeat = rt.time, 0.0     # lockstep: sim time granted; last wall beat
         self._make_publishers()

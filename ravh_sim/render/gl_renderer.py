@@ -216,16 +216,16 @@ class GLRenderer:
             self._render_coverage()
             self._lights_on, self._sun_angle = None, None
             self._shadowed.clear()
-        on = frozenset(k for k, v in world.settings.lights.items() if v)
-        sun_changed = world.settings.sun_angle != self._sun_angle
+        on = frozenset(k for k, v in world.state.lights.items() if v)
+        sun_changed = world.state.sun_angle != self._sun_angle
         if not sun_changed and on == self._lights_on:
             return
         switched = on ^ self._lights_on if self._lights_on is not None else None
-        sun = sun_light(world.settings.sun_angle)
+        sun = sun_light(world.state.sun_angle)
         lights = [lt for lt in world.house.lights if lt.id in on]
         self._upload_instances(sun, lights)
         self._set_lighting(sun, lights)
-        self._sun_angle, self._lights_on = world.settings.sun_angle, on
+        self._sun_angle, self._lights_on = world.state.sun_angle, on
         if not self.shadows:
             return
         if sun_changed:
@@ -393,7 +393,7 @@ class GLRenderer:
         to what it can see) those joined to it by an open door or an archway."""
         rooms = {room}
         if self.shadows:
-            doors = self.world.settings.doors
+            doors = self.world.state.doors
             for link in room_links(self.world.house):
                 if room in link.rooms and (link.door is None or doors.get(link.door, True)):
                     rooms.update(link.rooms)
@@ -499,7 +499,7 @@ class GLRenderer:
         self.coverage_fbo.clear(0.0, 0.0, 0.0, 0.0)
         ctx.disable(ctx.DEPTH_TEST)
         ctx.disable(ctx.CULL_FACE)
-        self._upload_instances(sun_light(self.world.settings.sun_angle), [])
+        self._upload_instances(sun_light(self.world.state.sun_angle), [])
         assert self.instance_texture is not None, "uploaded just above"
         self.instance_texture.use(0)
         _uniform(self.coverage_program, "u_instances").value = 0

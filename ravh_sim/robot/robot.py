@@ -100,7 +100,7 @@ class Robot:
         self._limits = (MOTOR_FORCE_MARGIN * mass * profile.max_linear_acceleration,
                         MOTOR_FORCE_MARGIN * inertia * profile.max_angular_acceleration)
         self._place(*pose)
-        rng = random.Random(f"{world.settings.seed if seed is None else seed}/odometry/{name}")
+        rng = random.Random(f"{world.state.seed if seed is None else seed}/odometry/{name}")
         self._odometry = Odometry(self._pose, profile.odom_linear_sigma, profile.odom_angular_sigma, rng)
 
     # ------------------------------------------------------------------ body

@@ -5,7 +5,7 @@ several agents share one clock and one set of contacts: they collide with each o
 house. The ROS node owns one and calls :meth:`Simulation.step` from its timer.
 
 A start pose that overlaps something a little (a station close to a wall) is moved just clear of it
-(see ``Robot._place``); the world's settings then record where the robot really starts, so the
+(see ``Robot._place``); the world's state then records where the robot really starts, so the
 footprint never claims a pose the robot is not at, and a world rebuilt from that footprint starts the
 robot exactly there. A start that cannot be freed that way (inside a sofa, wedged between a shower
 and a basin) is refused with a UserError that names the nearest free pose on the free-space map.
@@ -38,7 +38,7 @@ class Simulation:
         self.dt = 1.0 / world.physics_hz
         self.steps = 0
         self.robots: dict[str, Robot] = {}
-        specs = world.settings.agents if agents is None else agents
+        specs = world.state.agents if agents is None else agents
         for spec in specs:
             if spec.name in self.robots:
                 raise ValueError(f"duplicate agent name {spec.name!r}")
@@ -48,7 +48,7 @@ class Simulation:
                 raise UserError(f"agent {spec.name!r}: start pose {list(spec.pose)} is inside an obstacle; "
                                 f"nearest free pose: {_nearest_free_pose(world, profile, spec.pose)}")
         if agents is None:
-            world.settings.agents = [self._started(spec) for spec in specs]
+            world.state.write(agents=[self._started(spec) for spec in specs])
 
     def _started(self, spec: AgentSpec) -> AgentSpec:
         """``spec`` with the pose its robot really starts at, if placing moved it."""
@@ -82,7 +82,7 @@ class Simulation:
 
 def _nearest_free_pose(world: World, profile: RobotProfile, pose: tuple[float, float, float]) -> list[float]:
     """[x, y, yaw]: the free-space map's free cell nearest ``pose`` (yaw kept), where the robot fits."""
-    grid = free_space(world.house, world.settings.doors, world.settings.models, profile.radius, profile.height)
+    grid = free_space(world.house, world.state.doors, world.state.models, profile.radius, profile.height)
     xs, ys = grid.cell_centres()
     d2 = np.where(grid.data == FREE, (xs - pose[0]) ** 2 + (ys - pose[1]) ** 2, np.inf)
     row, col = np.unravel_index(int(np.argmin(d2)), d2.shape)

@@ -155,20 +155,20 @@ class SmartCamera:
             views = self.gl.render(position, rotation, self.options.manual_exposure)
             return Frame(views.rgb, views.depth, views.instance, views.background, position, rotation)
         rgb, depth, instance, background = self._render(position, rotation,
-                                                         sun_light(self.world.settings.sun_angle).direction)
+                                                         sun_light(self.world.state.sun_angle).direction)
         return Frame(rgb, depth, instance, background, position, rotation)
 
     def capture(self, x: float, y: float, yaw: float, floor_z: float | None = None,
                 velocity: tuple[float, float] = (0.0, 0.0)) -> Capture:
         """Render the view from robot pose (x, y, yaw); ``velocity`` (v m/s, w rad/s) for motion blur."""
         opts = self.options
-        settings = self.world.settings
-        sun = sun_light(settings.sun_angle)
+        state = self.world.state
+        sun = sun_light(state.sun_angle)
         frame = self.render(x, y, yaw, floor_z)
         rgb, depth, instance = frame.rgb, frame.depth, frame.instance
         if self.lighting is not None:
             rgb = self._tiny_lighting(frame, sun)
-        rng = np.random.default_rng([settings.seed, NOISE_STREAM, self.count])
+        rng = np.random.default_rng([state.seed, NOISE_STREAM, self.count])
         if opts.motion_blur and any(velocity):
             distance = float(np.nanmedian(depth)) if np.isfinite(depth).any() else self.spec.far
             rgb = imaging.motion_blur(rgb, self.K, velocity[0], velocity[1], opts.exposure, distance)
@@ -190,8 +190,7 @@ class SmartCamera:
     def _tiny_lighting(self, frame: Frame, sun) -> np.ndarray:
         """The TinyRenderer fallback's lighting pass: daylight, lamps, sky in the background."""
         assert self.lighting is not None
-        settings = self.world.settings
-        lights = [lt for lt in self.world.house.lights if settings.lights.get(lt.id, False)]
+        lights = [lt for lt in self.world.house.lights if self.world.state.lights.get(lt.id, False)]
         rgb = self.lighting.apply(frame.rgb, frame.depth, frame.instance, frame.rotation, frame.position,
                                   sun, lights)
         if frame.background.any():
@@ -248,8 +247,8 @@ def write_capture(camera: SmartCamera, capture: Capture, directory: Path) -> lis
             "robot_pose": list(capture.robot_pose), "frame_id": capture.camera_info.frame_id,
             "camera_position": [float(v) for v in capture.position],
             "camera_orientation": list(capture.orientation), "K": capture.K.tolist(),
-            "camera_info": asdict(capture.camera_info), "sun_angle": camera.world.settings.sun_angle,
-            "lights_on": sorted(k for k, on in camera.world.settings.lights.items() if on),
+            "camera_info": asdict(capture.camera_info), "sun_angle": camera.world.state.sun_angle,
+            "lights_on": sorted(k for k, on in camera.world.state.lights.items() if on),
             "depth_png": "uint16 millimetres along the optical axis, 0 = no depth",
             "pixels_without_instance": int(counts[0]), "instances": visible}
     atomic_write(paths[3], (json.dumps(info, indent=1) + "\n").encode())

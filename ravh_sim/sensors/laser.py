@@ -70,7 +70,7 @@ class Laser:
         bodies, distances = self._trace(np.array([x, y, z]), directions, self.world.ray_mask(ignore_bodies))
         ranges = distances.astype(np.float32)
         if spec.noise_sigma > 0:
-            rng = np.random.default_rng([self.world.settings.seed, NOISE_STREAM, self.count])
+            rng = np.random.default_rng([self.world.state.seed, NOISE_STREAM, self.count])
             noisy = ranges + rng.standard_normal(len(ranges)).astype(np.float32) * spec.noise_sigma
             ranges = np.where(np.isfinite(ranges), np.clip(noisy, spec.range_min, spec.range_max), ranges)
         ranges[ranges < spec.range_min] = -np.inf

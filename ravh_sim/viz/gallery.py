@@ -74,7 +74,7 @@ def gallery(house_number: int, output: Path, seed: int = 0,
             panels.append(_labelled(camera.capture(*pose).rgb, label))
         appearance.randomise(seed + 1)
         panels.append(_labelled(camera.capture(*pose).rgb,
-                                f"random: sun {world.settings.sun_angle:.0f} deg, paint, models, lights"))
+                                f"random: sun {world.state.sun_angle:.0f} deg, paint, models, lights"))
         camera.close()
     sheet = np.vstack([np.hstack(panels[:3]), np.hstack(panels[3:])])
     output.parent.mkdir(parents=True, exist_ok=True)

@@ -1,11 +1,12 @@
 """Appearance managers: sun, lights, paint, object models and doors, changed at run time.
 
-Every change goes through :class:`Appearance` and lands in ``world.settings`` (the resolved settings),
-so the footprint always describes what the sensors see. Paint, models and doors change pybullet
-bodies (through the World, no rebuild); the sun and the lights are read by the camera at capture time
-(pybullet renders one directional light, the rest is the camera's lighting pass), so switching them
-costs nothing. Random choices go through :func:`settings.resolve`, so "random" here picks exactly what
-the same seed picks in a settings file.
+:class:`Appearance` is the one writer of a world's live state (``world.state``, see
+:mod:`ravh_sim.world.state`): the CLI, the benchmarks, the gallery and the ROS appearance service
+(:meth:`Appearance.change`, which speaks the request language of :mod:`ravh_msgs_py.appearance`) all
+change a world through it, so the footprint always describes what the sensors see. Paint, models and
+doors change pybullet bodies (through the World's primitives, no rebuild); the sun and the lights are
+read by the camera at capture time, so switching them costs nothing. Random choices go through
+:func:`settings.resolve`, so "random" here picks exactly what the same seed picks in a settings file.
 
 The sun model (:func:`sun_light`) is here too: one angle gives the light direction, the colour and
 level of daylight indoors and the sky colour seen beyond the house and through the windows.
@@ -14,22 +15,20 @@ from __future__ import annotations
 
 import copy
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
+from ravh_msgs_py.appearance import LIGHT_GROUPS, SUN_PRESETS, SURFACES, SWITCH
+from ravh_msgs_py.query import UNKNOWN_ID, QueryError
 from ravh_sim.errors import UnknownNameError, UserError
 from ravh_sim.world import paints
 from ravh_sim.world.furniture import variant_count
-from ravh_sim.world.house import LIGHT_KINDS, Light
 from ravh_sim.world.scene import World
-from ravh_sim.world.settings import SUN_PRESETS, Resolved, load_settings, resolve
+from ravh_sim.world.settings import Resolved, light_group, load_settings, resolve
 
 RGB = tuple[float, float, float]
-
-LIGHT_GROUPS = ("all", *LIGHT_KINDS)
-SWITCH_STATES = ("on", "off", "random")
-SURFACES = ("walls", "floor")
 
 # Daylight indoors (multiplies pybullet's render) and sky colours, from night to noon.
 NIGHT_LEVEL = 0.12
@@ -72,20 +71,22 @@ def sun_light(angle: float) -> SunLight:
     night = tuple(NIGHT_LEVEL * c for c in NIGHT_COLOUR)
     gain = _lerp(night, tuple(day_level * c for c in day_colour), daylight)
     sky = _lerp(SKY_NIGHT, _lerp(SKY_HORIZON, SKY_NOON, height), daylight)
-    return SunLight(a, direction, gain, tuple(int(round(c)) for c in sky))
+    red, green, blue = (int(round(c)) for c in sky)
+    return SunLight(a, direction, gain, (red, green, blue))
 
 
 class Appearance:
-    """Run-time changes to how a house looks; every change is recorded in ``world.settings``."""
+    """Run-time changes to how a house looks: the only writer of ``world.state``'s appearance."""
 
     def __init__(self, world: World) -> None:
         self.world = world
         self.house = world.house
+        self.state = world.state
 
     # ------------------------------------------------------------------ sun and lights
     @property
     def sun(self) -> SunLight:
-        return sun_light(self.world.settings.sun_angle)
+        return sun_light(self.state.sun_angle)
 
     def set_sun(self, angle: float | str) -> None:
         """Sun angle in degrees [0, 360] or a preset name (day, sunset, night)."""
@@ -95,26 +96,22 @@ class Appearance:
             angle = SUN_PRESETS[angle]
         if not (isinstance(angle, (int, float)) and math.isfinite(angle) and 0.0 <= angle <= 360.0):
             raise UserError(f"sun angle must be degrees in [0, 360], got {angle!r}")
-        self.world.settings.sun_angle = float(angle)
+        self.state.write(sun_angle=float(angle))
 
     def set_light(self, light_id: str, on: bool) -> None:
         if light_id not in self.house.light_by_id:
             raise UnknownNameError("light", light_id, list(self.house.light_by_id))
-        self.world.settings.lights[light_id] = bool(on)
+        self.state.write(lights={light_id: bool(on)})
 
     def set_lights(self, which: str = "all", state: str = "on", seed: int | None = None) -> None:
-        """Switch every light of a kind (ceiling, lamp, wall) or all of them on, off or at random."""
+        """Switch a light group (all, ceiling, lamps) on, off or at random."""
         if which not in LIGHT_GROUPS:
             raise UnknownNameError("light group", which, list(LIGHT_GROUPS))
-        if state not in SWITCH_STATES:
-            raise UnknownNameError("light state", state, list(SWITCH_STATES))
-        chosen = [lt.id for lt in self.house.lights if which in ("all", lt.kind)]
+        if state not in SWITCH:
+            raise UnknownNameError("light state", state, list(SWITCH))
+        chosen = self._lights_named(which)
         states = self._resolve({"lights": {"set": {lid: state for lid in chosen}}}, seed).lights
-        for lid in chosen:
-            self.set_light(lid, states[lid])
-
-    def lights_on(self) -> list[Light]:
-        return [lt for lt in self.house.lights if self.world.settings.lights.get(lt.id, False)]
+        self.state.write(lights={lid: states[lid] for lid in chosen})
 
     # ------------------------------------------------------------------ bodies
     def set_paint(self, room_id: str, surface: str, paint: str) -> None:
@@ -123,7 +120,8 @@ class Appearance:
             raise UnknownNameError("surface", surface, list(SURFACES))
         if not paints.is_paint(paint):
             raise UnknownNameError("paint", paint, paints.all_paints() + ["#rrggbb"])
-        self.world.set_paint(room_id, surface, paint)
+        self.world.repaint(room_id, surface, paint)
+        self.state.write(paint={room_id: {surface: paint}})
 
     def set_object_model(self, object_id: str, model: int | str | dict[str, str],
                          seed: int | None = None) -> int:
@@ -134,7 +132,7 @@ class Appearance:
         if isinstance(model, dict):
             if set(model) != {"inherit"}:
                 raise UserError(f"model must be {{'inherit': OBJECT_ID}}, got {model!r}")
-            index = self.world.settings.models[self.house.object(model["inherit"]).id]
+            index = self.state.models[self.house.object(model["inherit"]).id]
         elif model == "random":
             index = self._resolve({"models": {"set": {object_id: "random"}}}, seed).models[object_id]
         elif isinstance(model, int):
@@ -144,32 +142,21 @@ class Appearance:
         count = variant_count(obj.type)
         if not 0 <= index < count:
             raise UserError(f"{object_id}: model index must be in 0..{count - 1}, got {index}")
-        if index != self.world.settings.models[object_id]:
-            self.world.set_object_model(object_id, index)
+        if index != self.state.models[object_id]:
+            self.world.load_model(object_id, index)
+            self.state.write(models={object_id: index})
         return index
 
     def set_door(self, door_id: str, is_open: bool) -> None:
         if door_id not in self.house.door_by_id:
             raise UnknownNameError("door", door_id, list(self.house.door_by_id))
-        self.world.set_door_open(door_id, bool(is_open))
+        self.world.place_door(door_id, bool(is_open))
+        self.state.write(doors={door_id: bool(is_open)})
 
     # ------------------------------------------------------------------ whole settings
     def apply(self, target: Resolved) -> None:
         """Bring the world to ``target`` (sun, lights, doors, paint, models), changing only what differs."""
-        current = self.world.settings
-        self.set_sun(target.sun_angle)
-        for lid, on in target.lights.items():
-            self.set_light(lid, on)
-        for did, is_open in target.doors.items():
-            if current.doors[did] != is_open:
-                self.set_door(did, is_open)
-        for room_id, surfaces in target.paint.items():
-            for surface, paint in surfaces.items():
-                if current.paint[room_id][surface] != paint:
-                    self.set_paint(room_id, surface, paint)
-        for oid, model in target.models.items():
-            if current.models[oid] != model:
-                self.set_object_model(oid, model)
+        self._bring(target.sun_angle, target.lights, target.doors, target.paint, target.models)
 
     def randomise(self, seed: int) -> Resolved:
         """Random sun, lights, doors, paint and models (what a settings file of 'random' gives for
@@ -179,14 +166,91 @@ class Appearance:
                                 "paint": {"walls": "random", "floors": "random"},
                                 "models": {"all": "random"}}, seed)
         self.apply(target)
-        return self.world.settings
+        return self.state.settings()
 
-    def _resolve(self, overrides: dict[str, dict[str, Any]], seed: int | None) -> Resolved:
+    def change(self, request: dict[str, Any]) -> dict[str, Any]:
+        """Apply a parsed appearance request (:func:`ravh_msgs_py.appearance.parse`) and return the
+        reply's result. Names are checked against the house and every choice is resolved like a settings
+        file (same seed rules) before anything changes; only the items the request names change."""
+        if "randomise" in request:
+            return {"settings": self.randomise(int(request["randomise"])).to_dict()}
+        self._check_names(request)
+        lights, doors, rooms, models = {}, {}, {}, {}
+        inherit = {}
+        for which, state in request.get("lights", {}).items():
+            lights.update(dict.fromkeys(self._lights_named(which), state))
+        for door, state in request.get("doors", {}).items():
+            for d in self._named(door, self.house.door_by_id):
+                doors[d] = {True: "open", False: "closed"}.get(state, state)
+        for room, surfaces in request.get("paint", {}).items():
+            rooms.update({r: dict(surfaces) for r in self._named(room, self.house.room_by_id)})
+        for obj, model in request.get("models", {}).items():
+            for o in self._named(obj, self.house.object_by_id):
+                if isinstance(model, dict):
+                    inherit[o] = self.house.object(model["inherit"]).id
+                else:
+                    models[o] = model
+        overrides: dict[str, dict[str, Any]] = {"lights": {"set": lights}, "doors": {"set": doors},
+                                                "paint": {"rooms": rooms}, "models": {"set": models}}
+        if "sun_angle" in request:
+            overrides["lights"]["sun_angle"] = request["sun_angle"]
+        picked = self._resolve(overrides, request.get("seed"), "appearance request")
+        chosen_models = {o: picked.models[o] for o in models}
+        for obj, source in inherit.items():
+            chosen_models[obj] = chosen_models.get(source, self.state.models[source])
+        self._bring(picked.sun_angle if "sun_angle" in request else None,
+                    {lid: picked.lights[lid] for lid in lights}, {d: picked.doors[d] for d in doors},
+                    {r: {s: picked.paint[r][s] for s in surfaces} for r, surfaces in rooms.items()},
+                    chosen_models)
+        return {"settings": self.state.settings().to_dict()}
+
+    def _bring(self, sun_angle: float | None, lights: Mapping[str, bool], doors: Mapping[str, bool],
+               paint: Mapping[str, Mapping[str, str]], models: Mapping[str, int]) -> None:
+        """Change the items given that differ, in the house's order (sun, lights, doors, paint, models)."""
+        state = self.state
+        if sun_angle is not None:
+            self.set_sun(sun_angle)
+        for lid in state.lights:
+            if lid in lights:
+                self.set_light(lid, lights[lid])
+        for did, is_open in state.doors.items():
+            if did in doors and doors[did] != is_open:
+                self.set_door(did, doors[did])
+        for room_id, surfaces in state.paint.items():
+            for surface, paint_now in surfaces.items():
+                if surface in paint.get(room_id, {}) and paint[room_id][surface] != paint_now:
+                    self.set_paint(room_id, surface, paint[room_id][surface])
+        for oid, model in state.models.items():
+            if oid in models and models[oid] != model:
+                self.set_object_model(oid, models[oid])
+
+    def _lights_named(self, which: str) -> list[str]:
+        """The lights of a group (LIGHT_GROUPS) or the one light named ``which``."""
+        if which in LIGHT_GROUPS:
+            return [lt.id for lt in self.house.lights if which in ("all", light_group(lt))]
+        return [which]
+
+    @staticmethod
+    def _named(name: str, known: Mapping[str, Any]) -> list[str]:
+        return list(known) if name == "all" else [name]
+
+    def _check_names(self, request: dict[str, Any]) -> None:
+        h = self.house
+        for key, kind, known, groups in (("doors", "door", h.door_by_id, ("all",)),
+                                         ("lights", "light", h.light_by_id, LIGHT_GROUPS),
+                                         ("paint", "room", h.room_by_id, ("all",)),
+                                         ("models", "object", h.object_by_id, ("all",))):
+            for name in request.get(key, {}):
+                if name not in groups and name not in known:
+                    raise QueryError(UNKNOWN_ID, f"unknown {kind} {name!r}", [*groups, *known])
+
+    def _resolve(self, overrides: dict[str, dict[str, Any]], seed: int | None,
+                 source: str = "appearance") -> Resolved:
         """Resolve the default settings with ``overrides`` for this house (random picks by seed)."""
         cfg = _default_settings()
         for section, values in overrides.items():
             cfg[section] = {**cfg[section], **values}
-        return resolve(cfg, self.house, self.world.settings.seed if seed is None else seed, "appearance")
+        return resolve(cfg, self.house, self.state.seed if seed is None else seed, source)
 
 
 @lru_cache(maxsize=1)

@@ -9,6 +9,7 @@ from which the World rebuilds exactly the same scene.
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -63,8 +64,8 @@ def build_instances(house: House) -> list[Instance]:
             for i, (name, kind, room, type_, tags) in enumerate(specs, start=1)]
 
 
-def instance_pose(house: House, settings: Resolved, inst: Instance) -> dict[str, Any]:
-    """Position, orientation and model of an instance under ``settings``."""
+def instance_pose(house: House, models: Mapping[str, int], inst: Instance) -> dict[str, Any]:
+    """Position, orientation and model of an instance when objects have ``models``."""
     if inst.kind in STRUCTURE_KINDS:
         room = house.room(inst.room)
         cx, cy = polygon_centroid(room.floor)
@@ -72,19 +73,20 @@ def instance_pose(house: House, settings: Resolved, inst: Instance) -> dict[str,
         return {"position": _r([cx, cy, z[inst.kind]]), "orientation": [0.0, 0.0, 0.0, 1.0], "yaw": 0.0,
                 "model": None, "size": None}
     obj = house.object(inst.name)
-    model = settings.models[obj.id]
+    model = models[obj.id]
     box = obj.box(model)
     return {"position": _r(box.position), "orientation": _r(quaternion_from_yaw(obj.yaw)),
             "yaw": _r(obj.yaw), "model": model, "size": _r(box.size)}
 
 
 def make_footprint(house: House, settings: Resolved) -> dict[str, Any]:
-    """The footprint document (JSON-ready)."""
+    """The footprint document (JSON-ready) of a world with ``settings``: for a running world, the
+    record of its live state (``world.state.settings()``), so it describes what the sensors see."""
     rows = []
     for inst in build_instances(house):
         row = {"id": inst.id, "name": inst.name, "kind": inst.kind, "mask_color": list(inst.mask_color),
                "room": inst.room, "room_type": inst.room_type, "type": inst.type, "tags": list(inst.tags)}
-        row.update(instance_pose(house, settings, inst))
+        row.update(instance_pose(house, settings.models, inst))
         if inst.kind == "door":
             row["open"] = settings.doors[inst.name]
         if inst.name in settings.lights:

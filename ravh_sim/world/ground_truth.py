@@ -1,29 +1,31 @@
 """The Environment Manager's ground truth: answers the query language of ``ravh_msgs_py.query``.
 
-Answers come from the house model, the resolved settings (door states, chosen models) and the
-instance table, so the same engine serves ``ravh query``, the Python API and the ROS service, with or
-without a running pybullet world. :meth:`GroundTruth.answer` never raises: every failure, including
-a bug, becomes a structured error reply.
+Answers come from the house model, a world's state (door states, chosen models: the live
+:class:`~ravh_sim.world.state.WorldState` of a running world, or ``WorldState(resolved)`` without one)
+and the instance table, so the same engine serves ``ravh query``, the Python API and the ROS service.
+:meth:`GroundTruth.answer` never raises: every failure, including a bug, becomes a structured error
+reply.
 """
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Callable
 from typing import Any
 
 from ravh_msgs_py import query as q
 from ravh_sim.world.footprint import build_instances, instance_pose
 from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import House, HouseObject, Room
-from ravh_sim.world.settings import Resolved
+from ravh_sim.world.state import WorldState
 from ravh_sim.world.topology import room_links
 
 
 class GroundTruth:
-    def __init__(self, house: House, settings: Resolved) -> None:
+    def __init__(self, house: House, state: WorldState) -> None:
         self.house = house
-        self.settings = settings
+        self.state = state
         self.instances = {inst.name: inst for inst in build_instances(house)}
-        self._handlers = {
+        self._handlers: dict[str, Callable[..., Any]] = {
             "help": lambda: q.describe(),
             "rooms": self._rooms, "room": self._room, "objects_in_room": self._objects_in_room,
             "objects_with_tag": self._objects_with_tag, "object": self._object, "room_at": self._room_at,
@@ -65,7 +67,7 @@ class GroundTruth:
 
     def _object_summary(self, obj: HouseObject) -> dict[str, Any]:
         inst = self.instances[obj.id]
-        pose = instance_pose(self.house, self.settings, inst)
+        pose = instance_pose(self.house, self.state.models, inst)
         return {"id": obj.id, "type": obj.type, "tags": list(obj.tags), "room": obj.room,
                 "room_type": inst.room_type, "instance_id": inst.id, "mask_color": list(inst.mask_color),
                 **pose}
@@ -105,15 +107,15 @@ class GroundTruth:
         if id not in self.house.door_by_id:
             raise q.QueryError(q.UNKNOWN_ID, f"unknown door {id!r}", list(self.house.door_by_id))
         door = self.house.door_by_id[id]
-        return {"id": door.id, "rooms": list(door.rooms), "open": self.settings.doors[door.id],
+        return {"id": door.id, "rooms": list(door.rooms), "open": self.state.doors[door.id],
                 "position": list(door.position), "yaw": door.yaw, "width": door.width,
                 "to_outside": len(door.rooms) == 1}
 
     def _connectivity(self, open_only: bool = False) -> dict[str, Any]:
         """Rooms joined by doors and by open passages (archways without a door)."""
-        edges = []
+        edges: list[dict[str, Any]] = []
         for link in room_links(self.house):
-            is_open = True if link.door is None else self.settings.doors[link.door]
+            is_open = True if link.door is None else self.state.doors[link.door]
             if is_open or not open_only:
                 edges.append({"rooms": list(link.rooms), "door": link.door, "open": is_open,
                               "position": list(link.position), "width": link.width})

@@ -5,9 +5,13 @@ Like gym-pybullet-drones' BaseAviary, one class owns the physics client: it buil
 object, door, window and each room's floor, ceiling and walls, each with a unique id and mask colour)
 and changes the house at run time (doors, object models, paint) without rebuilding it.
 
+The World owns the live :class:`~ravh_sim.world.state.WorldState` (:attr:`World.state`, started from
+the settings) but does not write it: :class:`ravh_sim.world.appearance.Appearance` does, moving bodies
+through the primitives here (:meth:`World.place_door`, :meth:`World.load_model`, :meth:`World.repaint`).
+
 It also keeps what every body looks like (:attr:`World.visuals`: the mesh, its paint) and a
-:attr:`World.revision` that grows with every visible change, so a renderer (ravh_sim.render) can
-rebuild its GPU copy of the house only when something changed. pybullet's own renderer is used only
+:attr:`World.revision` that grows with every change to them (doors, models, paint), so a renderer
+(ravh_sim.render) can rebuild its GPU copy of the house only when one happened. pybullet's own renderer is used only
 by the TinyRenderer fallback; the EGL plugin is never loaded (one GL context per process belongs to
 ravh_sim.render).
 """
@@ -35,6 +39,7 @@ from ravh_sim.world.mesh import Mesh, hulls_obj_text
 from ravh_sim.world.palette import PALETTE
 from ravh_sim.world.settings import Resolved
 from ravh_sim.world.solids import Placed, door_pose, object_parts
+from ravh_sim.world.state import WorldState
 from ravh_sim.world.structure import TexturedMesh, floor_mesh, solid_walls, wall_mesh
 
 NON_SOLID_TYPES = frozenset({"Station"})      # drawn, but the robot starts on it
@@ -71,12 +76,12 @@ class World:
     def __init__(self, house: House, settings: Resolved, renderer: str = "auto",
                  physics_hz: float = 240.0) -> None:
         self.house = house
-        self.settings = settings
+        self.state = WorldState(settings)
         self.physics_hz = physics_hz
         self.renderer = resolve_backend(renderer)
         self.client = connect()
         self.visuals: dict[int, Visual] = {}     # pybullet body -> what it looks like
-        self.revision = 0                          # grows with every change a camera can see
+        self.revision = 0                          # grows with every change to a body's look or place
         pb.setGravity(0, 0, -9.81, physicsClientId=self.client)
         pb.setTimeStep(1.0 / physics_hz, physicsClientId=self.client)
         self._assets = cache_dir()
@@ -152,9 +157,9 @@ class World:
             if inst.kind in STRUCTURE_KINDS:
                 inst.body = self._structure_body(inst)
             else:
-                inst.body = self._object_body(self.house.object(inst.name), self.settings.models[inst.name])
+                inst.body = self._object_body(self.house.object(inst.name), self.state.models[inst.name])
                 if inst.kind == "door":
-                    self.set_door_open(inst.name, self.settings.doors[inst.name])
+                    self.place_door(inst.name, self.state.doors[inst.name])
         self._building = False
         self._flush_looks()
 
@@ -163,10 +168,10 @@ class World:
         if inst.kind == "walls":
             walls = solid_walls(self.house, room.id)
             body = self._mesh_body(wall_mesh(walls, self.house.windows), self._wall_collision(walls), "walls")
-            self._apply_paint(body, self.settings.paint[room.id]["walls"])
+            self._apply_paint(body, self.state.paint[room.id]["walls"])
         elif inst.kind == "floor":
             body = self._mesh_body(floor_mesh(room, room.floor_z), -1, "floor")
-            self._apply_paint(body, self.settings.paint[room.id]["floor"])
+            self._apply_paint(body, self.state.paint[room.id]["floor"])
         else:
             body = self._mesh_body(floor_mesh(room, room.ceiling_z, facing_up=False), -1, "ceiling")
             self._apply_paint(body, CEILING_PAINT)
@@ -185,7 +190,7 @@ class World:
 
     def _object_body(self, obj: HouseObject, model: int) -> int:
         """The object's model, colliding part by part (see :mod:`ravh_sim.world.solids`); a door is
-        its leaf, which :meth:`set_door_open` then puts in the doorway or out of the house."""
+        its leaf, which :meth:`place_door` then puts in the doorway or out of the house."""
         placed = object_parts(self.house, obj, model)
         collision = -1 if obj.type in NON_SOLID_TYPES else self._parts_collision(placed)
         mesh = placed.mesh()
@@ -261,31 +266,29 @@ class World:
             pb.changeVisualShape(body, -1, textureUniqueId=texture, rgbaColor=rgba, physicsClientId=self.client)
         self._looks.clear()
 
-    # ------------------------------------------------------------------ run-time changes
-    def set_door_open(self, door_id: str, is_open: bool) -> None:
-        """Open (leaf out of the house, as upstream hides it) or close (leaf in the doorway) a door."""
+    # ------------------------------------------------------------------ body primitives (for Appearance)
+    def place_door(self, door_id: str, is_open: bool) -> None:
+        """Put a door's leaf out of the house (open, as upstream hides it) or in the doorway (closed)."""
         (x, y, z), yaw = door_pose(self.house, self.house.door_by_id[door_id])
         pb.resetBasePositionAndOrientation(self._by_name[door_id].body, [x, y, z - OPEN_DOOR_DROP * is_open],
                                            quaternion_from_yaw(yaw), physicsClientId=self.client)
-        self.settings.doors[door_id] = is_open
         self.revision += 1
 
-    def set_object_model(self, object_id: str, model: int) -> None:
-        """Swap an object's model variant (its visual and its collision box)."""
+    def load_model(self, object_id: str, model: int) -> None:
+        """Replace an object's body by model variant ``model`` (visual and collision); a door's new
+        leaf goes where the state says the door is."""
         inst = self._by_name[object_id]
         obj = self.house.object(object_id)
         pb.removeBody(inst.body, physicsClientId=self.client)
         del self.visuals[inst.body]
         inst.body = self._object_body(obj, model)
         self.revision += 1
-        self.settings.models[object_id] = model
         if inst.kind == "door":
-            self.set_door_open(object_id, self.settings.doors[object_id])
+            self.place_door(object_id, self.state.doors[object_id])
 
-    def set_paint(self, room_id: str, surface: str, paint: str) -> None:
-        """Repaint a room's ``walls`` or ``floor``."""
+    def repaint(self, room_id: str, surface: str, paint: str) -> None:
+        """Paint a room's ``walls`` or ``floor`` body."""
         self._apply_paint(self._by_name[f"{room_id}/{surface}"].body, paint)
-        self.settings.paint[room_id][surface] = paint
 
     # ------------------------------------------------------------------ poses
     def object_pose(self, name: str) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:

@@ -5,30 +5,32 @@ ceiling light on", "random paint", "door Door_2 closed"); :func:`resolve` turns 
 :class:`Resolved` value with one explicit choice per light, door, room and object. Every random choice
 comes from the single seed, drawn per item from a stream named after the item, so changing one item's
 setting never reshuffles the others, and the same seed and file always give the same world.
-The resolved settings go into the footprint, and a footprint rebuilds the world from them alone.
+The resolved settings are frozen: a World starts from them, and its live state
+(:mod:`ravh_sim.world.state`) is the current :class:`Resolved` value, replaced on each change. That
+value goes into the footprint, and a footprint rebuilds the world from it alone.
 """
 from __future__ import annotations
 
 import math
 import random
-from dataclasses import asdict, dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import Annotated, Any
 
 import yaml
 from pydantic import AfterValidator, Field
 
-from ravh_msgs_py.appearance import SEED_MAX
+from ravh_msgs_py.appearance import DOOR, SEED_MAX, SUN_PRESETS, SWITCH
 from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
 from ravh_sim.paths import DEFAULT_CONFIG, ROBOTS_DIR
 from ravh_sim.schema import Strict, read_text, shown, validate
 from ravh_sim.world import paints
 from ravh_sim.world.furniture import variant_count
-from ravh_sim.world.house import House
+from ravh_sim.world.house import House, Light
 
-SUN_PRESETS = {"day": 100.0, "sunset": 180.0, "night": 200.0}
-SWITCH = ("on", "off", "random")
-DOOR_STATES = ("default", "open", "closed", "random")
+DOOR_STATES = ("default", *DOOR)          # a settings file may also keep a door as the house has it
 AGENT_CLEARANCE = 0.5      # m between two agents' start positions (two Giraff radii)
 
 
@@ -109,7 +111,8 @@ class _Models(Strict):
 
 
 class _Agent(Strict):
-    name: Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")] = None
+    # no name: robot<i>; an explicit null is refused (the default is not validated, the value is)
+    name: Annotated[str, Field(default=None, min_length=1, max_length=64, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")]
     profile: Annotated[str, Field(min_length=1, max_length=64)] = "giraff"
     start: _checked(_check_start) = "station"
 
@@ -138,28 +141,50 @@ class AgentSpec:
     pose: tuple[float, float, float]         # x, y, yaw in the house frame
 
 
-@dataclass
+@dataclass(frozen=True)
 class Resolved:
-    """One explicit choice for every item: what the world is built from and what a footprint stores."""
+    """One explicit choice for every item: what a world is built from and what a footprint stores.
+
+    Frozen, mappings included (read-only views of private copies): a value that was handed to a World
+    or written into a footprint can never drift from what it recorded. Use ``dataclasses.replace`` to
+    derive another."""
     seed: int
     sun_angle: float
-    lights: dict[str, bool]
-    doors: dict[str, bool]                   # door id -> open
-    paint: dict[str, dict[str, str]]         # room id -> {"walls": paint, "floor": paint}
-    models: dict[str, int]                   # object id -> model variant
-    agents: list[AgentSpec] = field(default_factory=list)
+    lights: Mapping[str, bool]
+    doors: Mapping[str, bool]                # door id -> open
+    paint: Mapping[str, Mapping[str, str]]   # room id -> {"walls": paint, "floor": paint}
+    models: Mapping[str, int]                # object id -> model variant
+    agents: tuple[AgentSpec, ...] = ()
+
+    def __post_init__(self) -> None:
+        frozen = {"lights": MappingProxyType(dict(self.lights)), "doors": MappingProxyType(dict(self.doors)),
+                  "paint": MappingProxyType({room: MappingProxyType(dict(surfaces))
+                                             for room, surfaces in self.paint.items()}),
+                  "models": MappingProxyType(dict(self.models)), "agents": tuple(self.agents)}
+        for name, value in frozen.items():
+            object.__setattr__(self, name, value)
 
     def to_dict(self) -> dict[str, Any]:
-        d = asdict(self)
-        d["agents"] = [{"name": a.name, "profile": a.profile, "pose": list(a.pose)} for a in self.agents]
-        return d
+        return {"seed": self.seed, "sun_angle": self.sun_angle, "lights": dict(self.lights),
+                "doors": dict(self.doors), "paint": {room: dict(s) for room, s in self.paint.items()},
+                "models": dict(self.models),
+                "agents": [{"name": a.name, "profile": a.profile, "pose": list(a.pose)} for a in self.agents]}
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Resolved:
-        agents = [AgentSpec(a["name"], a["profile"], tuple(a["pose"])) for a in d.get("agents", [])]
-        return cls(seed=int(d["seed"]), sun_angle=float(d["sun_angle"]), lights=dict(d["lights"]),
-                   doors=dict(d["doors"]), paint={k: dict(v) for k, v in d["paint"].items()},
-                   models={k: int(v) for k, v in d["models"].items()}, agents=agents)
+        agents = tuple(AgentSpec(a["name"], a["profile"], _pose(a["pose"])) for a in d.get("agents", []))
+        return cls(seed=int(d["seed"]), sun_angle=float(d["sun_angle"]), lights=d["lights"], doors=d["doors"],
+                   paint=d["paint"], models={k: int(v) for k, v in d["models"].items()}, agents=agents)
+
+
+def _pose(values: Any) -> tuple[float, float, float]:
+    x, y, yaw = values
+    return (x, y, yaw)
+
+
+def light_group(light: Light) -> str:
+    """The group (ravh_msgs_py.appearance.LIGHT_GROUPS, besides "all") that switches ``light``."""
+    return "ceiling" if light.kind == "ceiling" else "lamps"
 
 
 def load_settings(path: Path | str | None = None) -> dict[str, Any]:
@@ -214,18 +239,19 @@ def _sun_angle(value: Any, pick: _Picker, source: str) -> float:
 
 
 def _switch(value: Any) -> str:
-    return {True: "on", False: "off"}.get(value, value) if isinstance(value, bool) else value
+    if isinstance(value, bool):       # YAML 1.1 reads on/off as booleans
+        return "on" if value else "off"
+    return value
 
 
 def _resolve_lights(cfg: dict, house: House, pick: _Picker, source: str) -> dict[str, bool]:
     per_light = _per_item(cfg, "lights.set", house.light_by_id, "light", source)
     out = {}
     for light in house.lights:
-        group = "ceiling" if light.kind == "ceiling" else "lamps"
         if light.id in per_light:
             state = _switch(per_light[light.id])
         else:
-            state = _switch(cfg[group])
+            state = _switch(cfg[light_group(light)])
         out[light.id] = pick.coin("light", light.id) if state == "random" else state == "on"
     return out
 
@@ -306,8 +332,9 @@ def _follow(obj_id: str, explicit: dict[str, int], inherit_from: dict[str, str])
     return explicit.get(obj_id, 0)
 
 
-def _resolve_agents(cfg: list[dict], house: House, source: str) -> list[AgentSpec]:
-    agents, names = [], set()
+def _resolve_agents(cfg: list[dict], house: House, source: str) -> tuple[AgentSpec, ...]:
+    agents: list[AgentSpec] = []
+    names = set()
     for i, a in enumerate(cfg):
         name = a.get("name") or f"robot{i}"
         if name in names:
@@ -324,7 +351,7 @@ def _resolve_agents(cfg: list[dict], house: House, source: str) -> list[AgentSpe
                 raise FileFieldError(source, f"agents[{i}].start", f"within {AGENT_CLEARANCE} m of agent "
                                      f"{other.name!r}'s start; give each agent its own start")
         agents.append(AgentSpec(name, profile, pose))
-    return agents
+    return tuple(agents)
 
 
 def _start_pose(value: Any, house: House, source: str, key: str) -> tuple[float, float, float]:
