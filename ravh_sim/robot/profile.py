@@ -14,6 +14,7 @@ from typing import Annotated, Any, Literal
 import yaml
 from pydantic import Field, model_validator
 
+from ravh_msgs_py.names import DEFAULT_PROFILE
 from ravh_sim.errors import FileFieldError, UnknownNameError
 from ravh_sim.paths import ROBOTS_DIR
 from ravh_sim.render.backend import QUALITIES
@@ -27,7 +28,7 @@ class LaserSpec:
     resolution_deg: float
     range_min: float
     range_max: float
-    rate: float              # Hz
+    rate: float              # Hz: scans published (and LaserScan.scan_time)
     noise_sigma: float       # m
 
     @property
@@ -51,7 +52,7 @@ class CameraSpec:
     focal_length: float      # mm
     near: float              # m
     far: float               # m
-    rate: float              # Hz
+    rate: float              # Hz: frames published
     quality: str = "realistic"   # realistic | fast (ravh_sim.render.backend.QUALITIES)
 
     @property
@@ -84,6 +85,7 @@ class RobotProfile:
     max_angular_acceleration: float  # rad/s^2
     odom_linear_sigma: float         # m per metre driven
     odom_angular_sigma: float        # rad per radian turned
+    odom_rate: float                 # Hz: odometry, ground-truth pose and /tf
     laser: LaserSpec
     camera: CameraSpec
     camera_effects: tuple[tuple[str, Any], ...] = ()   # CameraOptions fields set by the profile
@@ -102,7 +104,8 @@ Range = number(gt=0.0, le=1000.0)          # m
 Pixels = Annotated[int, Field(ge=16, le=8192)]
 
 
-class _Noise(Strict):
+class _Odometry(Strict):
+    rate: Rate
     linear_sigma: Sigma
     angular_sigma: Sigma
 
@@ -169,12 +172,12 @@ class ProfileFile(Strict):
     max_angular_speed: number(gt=0.0, le=1000.0)          # deg/s
     max_linear_acceleration: number(gt=0.0, le=100.0)     # m/s^2
     max_angular_acceleration: number(gt=0.0, le=10_000.0) # deg/s^2
-    odometry_noise: _Noise
+    odometry: _Odometry
     laser: _Laser
     camera: _Camera
 
 
-def load_profile(name_or_path: str | Path = "giraff") -> RobotProfile:
+def load_profile(name_or_path: str | Path = DEFAULT_PROFILE) -> RobotProfile:
     path = Path(name_or_path)
     if path.suffix not in (".yaml", ".yml"):
         path = ROBOTS_DIR / f"{name_or_path}.yaml"
@@ -191,8 +194,8 @@ def load_profile(name_or_path: str | Path = "giraff") -> RobotProfile:
         max_linear_speed=f.max_linear_speed, max_angular_speed=math.radians(f.max_angular_speed),
         max_linear_acceleration=f.max_linear_acceleration,
         max_angular_acceleration=math.radians(f.max_angular_acceleration),
-        odom_linear_sigma=f.odometry_noise.linear_sigma,
-        odom_angular_sigma=math.radians(f.odometry_noise.angular_sigma),
+        odom_linear_sigma=f.odometry.linear_sigma,
+        odom_angular_sigma=math.radians(f.odometry.angular_sigma), odom_rate=f.odometry.rate,
         laser=LaserSpec(lz.height, lz.fov, lz.resolution, lz.range_min, lz.range_max, lz.rate, lz.noise_sigma),
         camera=CameraSpec(cam.height, cam.pitch, cam.forward, cam.width, cam.height_px, cam.sensor_width,
                           cam.sensor_height, cam.focal_length, cam.near, cam.far, cam.rate, cam.quality),
