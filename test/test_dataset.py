@@ -17,6 +17,7 @@ from conftest import resolved
 from rosgraph import NodeProcess, remove_orphan_shm, spin_until, start_rclpy
 
 from ravh_msgs_py import names as n
+from ravh_msgs_py.capture import CaptureEvent
 from ravh_sim.dataset import layout
 from ravh_sim.dataset.api import MIN_PIXELS, Dataset
 from ravh_sim.dataset.summary import render_summary, write_summary
@@ -24,13 +25,15 @@ from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid
 from ravh_sim.sensors import imaging
+from ravh_sim.sensors.readings import CameraInfo, Scan
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.house import load_house
 
 H, W = 48, 64
-SCAN_META = {"angle_min": -math.pi, "angle_increment": math.radians(1.0), "range_min": 0.05, "range_max": 30.0}
 CAMERA = {"width": W, "height": H, "K": [50.0, 0, 32, 0, 50.0, 24, 0, 0, 1], "D": [0.0] * 5,
           "distortion_model": "plumb_bob", "frame_id": "camera_optical_frame"}
+INFO = CameraInfo(CAMERA["frame_id"], W, H, "plumb_bob", tuple(CAMERA["D"]), tuple(CAMERA["K"]),
+                  tuple(np.eye(3).ravel()), (50.0, 0, 32, 0, 0, 50.0, 24, 0, 0, 0, 1, 0))
 
 
 def footprint_of(number: int) -> dict:
@@ -58,7 +61,12 @@ def capture(rng: np.random.Generator, ids: list[int]) -> dict:
     ranges = rng.uniform(0.1, 10.0, 360).astype(np.float32)
     ranges[:3] = [np.inf, np.nan, 0.01]
     return {"rgb": rng.integers(0, 256, (H, W, 3), dtype=np.uint8), "depth": depth, "instance": instance,
-            "scan_ranges": ranges}
+            "rgb_info": INFO, "scan": Scan("laser_link", -math.pi, math.radians(179), math.radians(1.0), 0.0, 0.1,
+                                           0.05, 30.0, ranges)}
+
+
+def event(stamp: float, room: str | None, pose=(0.0, 0.0, 0.0), odom=(0.0, 0.0, 0.0)) -> CaptureEvent:
+    return CaptureEvent("robot", stamp, tuple(pose), room, tuple(odom))
 
 
 def write_dataset(root: Path, footprint: dict, poses: list[tuple[str | None, tuple[float, float, float]]],
@@ -77,8 +85,7 @@ def write_dataset(root: Path, footprint: dict, poses: list[tuple[str | None, tup
         for k, (room, pose) in enumerate(poses):
             ids = [r["id"] for r in objects if r["room"] == room][:6] if room else []
             arrays = capture(rng, ids)
-            index = w.write_capture(10.0 + k, "robot", pose, (pose[0] + 0.1, pose[1], pose[2]), room, **arrays,
-                                    scan_meta=SCAN_META, camera=CAMERA)
+            index = w.write_capture(event(10.0 + k, room, pose, (pose[0] + 0.1, pose[1], pose[2])), arrays)
             assert index == k
             written.append(arrays)
     return written
@@ -115,7 +122,7 @@ def test_round_trip(tmp_path, footprint20):
         assert np.array_equal(np.isnan(sample.depth), invalid)
         assert np.abs(sample.depth[~invalid] - arrays["depth"][~invalid]).max() <= 0.0005 + 1e-6
         scan = sample.scan
-        assert np.array_equal(scan.ranges, arrays["scan_ranges"], equal_nan=True)
+        assert np.array_equal(scan.ranges, arrays["scan"].ranges, equal_nan=True)
         assert scan.angles[0] == pytest.approx(-math.pi) and scan.angles[-1] == pytest.approx(math.radians(179))
         assert (scan.range_min, scan.range_max) == (pytest.approx(0.05), 30.0)
     mask = ds[0].mask
@@ -146,12 +153,10 @@ def test_a_crash_between_files_leaves_no_half_capture(tmp_path, footprint20, mon
     writer = DatasetWriter(tmp_path / "a")
     writer.write_footprint(footprint20)
     writer.write_meta(20, ["robot"])
-    writer.write_capture(1.0, "robot", (0, 0, 0), (0, 0, 0), room, **capture(np.random.default_rng(1), []),
-                         scan_meta=SCAN_META)
+    writer.write_capture(event(1.0, room), capture(np.random.default_rng(1), []))
     monkeypatch.setattr(layout, "atomic_write", dying_write)
     with pytest.raises(KeyboardInterrupt):
-        writer.write_capture(2.0, "robot", (0, 0, 0), (0, 0, 0), room, **capture(np.random.default_rng(2), []),
-                             scan_meta=SCAN_META)
+        writer.write_capture(event(2.0, room), capture(np.random.default_rng(2), []))
     a = tmp_path / "a"
     assert (a / "rgb/000001.png").exists() and (a / "depth/000001.png").exists()
     assert not (a / "mask/000001.png").exists() and (a / "mask/.000001.png.1.tmp").exists()
@@ -211,7 +216,7 @@ def test_objects_in_counts_visible_instances_by_type(tmp_path, footprint20):
         w.write_meta(20, ["robot"])
         arrays = capture(np.random.default_rng(0), [chairs[0]["id"], chairs[1]["id"], other["id"], door["id"]])
         arrays["instance"][-1, :MIN_PIXELS - 1] = tiny["id"]          # too small to count
-        w.write_capture(1.0, "robot", (0, 0, 0), (0, 0, 0), chairs[0]["room"], **arrays, scan_meta=SCAN_META)
+        w.write_capture(event(1.0, chairs[0]["room"]), arrays)
     ds = Dataset(ds_writer_root)
     assert ds.objects_in(ds[0]) == Counter({"Chair": 2, other["type"]: 1})
     assert ds.objects_in(ds[0], min_pixels=1)[tiny["type"]] == 1

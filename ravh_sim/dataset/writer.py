@@ -93,9 +93,11 @@ class DatasetWriter:
                                "room": room, "room_type": self._room_types.get(room) if room else None,
                                "files": files}
         stored = [port.store(values) for port in SENSORS]
-        for part in stored:
-            for kind, data in part.files.items():
-                layout.atomic_write(self.dir / files[kind], data)
+        contents = {kind: data for part in stored for kind, data in part.files.items()}
+        if contents.keys() != files.keys():
+            raise ValueError(f"the sensors stored files {sorted(contents)}, the layout has {sorted(files)}")
+        for kind, path in files.items():                   # in the layout's order (README)
+            layout.atomic_write(self.dir / path, contents[kind])
         for part in stored:
             row.update(part.row)
             for name, fact in part.agent_facts.items():
