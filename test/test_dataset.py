@@ -24,6 +24,7 @@ from ravh_sim.dataset.summary import render_summary, write_summary
 from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid
+from ravh_sim.nodes import convert
 from ravh_sim.sensors import imaging
 from ravh_sim.sensors.readings import CameraInfo, Scan
 from ravh_sim.world.footprint import make_footprint
@@ -290,7 +291,6 @@ def test_stamps_from_cdr_and_events_agree():
     from rclpy.serialization import serialize_message
     from sensor_msgs.msg import LaserScan
 
-    from ravh_sim.nodes import convert
     for seconds in (0.0, 353.6, 12.345678901, 1e6 + 0.1):
         data = serialize_message(LaserScan(header=convert.header(seconds, "laser_link")))
         assert rec.header_stamp_ns(data) == rec.event_stamp_ns(seconds)
@@ -324,14 +324,14 @@ def start_recorder(sim, out: Path, *args: str) -> NodeProcess:
     return rec
 
 
-def request_capture(sim) -> dict:
+def request_capture(sim) -> CaptureEvent:
     import rclpy
     from std_srvs.srv import Trigger
     _, node, client = sim
     future = client.call_async(Trigger.Request())
     rclpy.spin_until_future_complete(node, future, timeout_sec=20)
     assert future.done() and future.result().success
-    return json.loads(future.result().message)
+    return CaptureEvent.from_json(future.result().message)
 
 
 def rows(out: Path) -> int:
@@ -355,8 +355,8 @@ def test_recorder_writes_captures_and_a_bag(sim, tmp_path):
     assert ds.camera["robot"]["width"] == 640 and ds.camera["robot"]["frame_id"] == n.CAMERA_OPTICAL_FRAME
     room_types = rooms_of(ds.footprint)
     for sample, event in zip(ds, events):
-        assert sample.stamp == event["stamp"] and sample.pose == pytest.approx(event["pose"])
-        assert sample.room == event["room"] and sample.room_type == room_types.get(event["room"])
+        assert sample.stamp == event.stamp and sample.pose == pytest.approx(event.pose)
+        assert sample.room == event.room and sample.room_type == room_types.get(event.room)
         assert sample.rgb.shape == (480, 640, 3) and sample.instance.shape == (480, 640)
         assert np.isfinite(sample.depth).mean() > 0.5 and len(sample.scan.ranges) == 360
         ids = set(np.unique(sample.instance).tolist()) - {0}
@@ -380,8 +380,9 @@ def test_recorder_writes_captures_and_a_bag(sim, tmp_path):
         depth_conn = [c for c in bag.connections if c.topic == "/" + n.DEPTH_IMAGE]
         msgs = [typestore.deserialize_cdr(raw, c.msgtype) for c, _, raw in bag.messages(connections=depth_conn)]
     first = min(msgs, key=lambda m: (m.header.stamp.sec, m.header.stamp.nanosec))
-    assert first.header.stamp.sec + first.header.stamp.nanosec * 1e-9 == pytest.approx(ds[0].stamp)
-    depth = np.frombuffer(first.data, np.float32).reshape(480, 640)
+    assert convert.seconds(first.header.stamp) == pytest.approx(ds[0].stamp)
+    depth = convert.image_array(first)                       # a rosbags message: the same fields
+    assert depth.shape == (480, 640)
     valid = np.isfinite(depth)
     assert np.array_equal(valid, np.isfinite(ds[0].depth))
     assert np.abs(depth[valid] - ds[0].depth[valid]).max() <= 0.0005 + 1e-6

@@ -195,7 +195,7 @@ class SimNode(Node):
     def _on_step(self, agent: Agent, msg: TwistStamped) -> None:
         """Lockstep: the behaviour's command for the next step and the sim time it may run to."""
         self._on_cmd(agent, msg.twist)
-        self._allowed = max(self._allowed, msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9)
+        self._allowed = max(self._allowed, convert.seconds(msg.header.stamp))
         self._heartbeat = 0.0
 
     def _arrived(self) -> None:
