@@ -129,6 +129,13 @@ def test_profile_camera_effects_are_validated(tmp_path):
     good.write_text(yaml.safe_dump(data))
     effects = dict(load_profile(good).camera_effects)
     assert effects["pixel_noise"] == 3.0 and effects["distortion"] == (-0.1, 0.01, 0.0, 0.0, 0.0)
+    data["camera"]["effects"] = {"pixel_noise": None, "distortion": None}      # null: the camera's default
+    good.write_text(yaml.safe_dump(data))
+    assert dict(load_profile(good).camera_effects) == {}
+    data["camera"]["effects"] = {"distortion": [0.0, 0.0, 0.0, 0.0, 99.0]}
+    good.write_text(yaml.safe_dump(data))
+    with pytest.raises(FileFieldError, match="camera.effects.distortion"):
+        load_profile(good)
     data["camera"]["effects"] = {"sparkle": 1}
     bad = tmp_path / "bad.yaml"
     bad.write_text(yaml.safe_dump(data))

@@ -130,10 +130,10 @@ def which_agent(node: Node, wanted: str | None) -> tuple[str, bool, str]:
 
 def layout_from_ground_truth(client: RavhClient) -> Layout:
     """Room floors and ceiling lights from the sim's ground-truth queries."""
-    rooms = {}
+    rooms: dict[str, tuple[tuple[tuple[float, float], ...], ...]] = {}
     for summary in client.query("rooms"):
         room = client.query("room", id=summary["id"])
-        rooms[room["id"]] = (tuple(tuple(p) for p in room["floor"]),)
+        rooms[room["id"]] = (tuple((float(x), float(y)) for x, y in room["floor"]),)
     lights = tuple((o["room"], tuple(o["position"][:2])) for o in client.query("objects_with_tag", tag="Light"))
     return Layout(rooms, lights)
 

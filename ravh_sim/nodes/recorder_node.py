@@ -40,6 +40,7 @@ from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import OccupancyGrid, Odometry
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.publisher import Publisher
 from rclpy.qos import QoSProfile
 from rclpy.serialization import deserialize_message
 from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
@@ -208,7 +209,7 @@ class RecorderNode(Node):
         self.lost = 0                                 # captures announced but never stored
         self.failure: str | None = None               # the first write error (the worker thread's)
         self.exit_code = 0
-        self.recorded_pub = None
+        self.recorded_pub: Publisher | None = None        # made once the agent is known
         self.log = self.get_logger()
         self.topics: dict[str, str] = {}              # part -> resolved topic name
         for topic, (msg_type, in_dataset) in LATCHED.items():
@@ -218,11 +219,12 @@ class RecorderNode(Node):
                 if self.bag:
                     self.bag.add_topic(sub.topic_name, msg_type, latched=True)
                 self.topics[topic] = sub.topic_name
-        for topic, msg_type in STREAMS.items() if self.bag else ():
-            sub = self.create_subscription(msg_type, topic, lambda d, t=topic: self._on_stream(t, d), STATE_QOS,
-                                           raw=True)
-            self.bag.add_topic(sub.topic_name, msg_type, latched=False)
-            self.topics[topic] = sub.topic_name
+        if self.bag is not None:
+            for topic, msg_type in STREAMS.items():
+                sub = self.create_subscription(msg_type, topic, lambda d, t=topic: self._on_stream(t, d), STATE_QOS,
+                                               raw=True)
+                self.bag.add_topic(sub.topic_name, msg_type, latched=False)
+                self.topics[topic] = sub.topic_name
         SimWatchdog(self)
         self.create_timer(0.5, self._check_writes,
                           clock=rclpy.clock.Clock(clock_type=rclpy.clock.ClockType.STEADY_TIME))
@@ -266,10 +268,12 @@ class RecorderNode(Node):
             self._submit(self.writer.write_map, convert.grid_of(deserialize_message(data, OccupancyGrid)))
 
     def _on_stream(self, topic: str, data: bytes) -> None:
+        assert self.bag is not None, "streams are subscribed for the bag only"
         self.bag.write(self.topics[topic], self._now_ns(), data)
 
     def _on_part(self, key: str, data: bytes) -> None:
         now_ns, part = self._now_ns(), self.parts[key]
+        value: CaptureEvent | tuple[int, bytes]
         if self.bag and part.bag and not part.per_capture:
             self.bag.write(self.topics[key], now_ns, data)
         if key == "event":
@@ -311,6 +315,7 @@ class RecorderNode(Node):
 
     def _confirm(self, stamp: float, index: int) -> None:
         """Tell the behaviour its capture is stored (not possible any more once SIGINT shut ROS down)."""
+        assert self.recorded_pub is not None, "captures are matched only once the agent is known"
         try:
             self.recorded_pub.publish(String(data=CaptureRecorded(stamp, index).to_json()))
         except Exception:
