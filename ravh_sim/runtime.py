@@ -28,8 +28,7 @@ from ravh_sim.robot.profile import RobotProfile, load_profile
 from ravh_sim.robot.robot import Robot
 from ravh_sim.robot.simulation import Simulation
 from ravh_sim.schema import shown
-from ravh_sim.sensors.camera import Capture, SmartCamera
-from ravh_sim.sensors.laser import Laser
+from ravh_sim.sensors.camera import Capture
 from ravh_sim.sensors.ports import Mount
 from ravh_sim.sensors.readings import Scan
 from ravh_sim.sensors.suite import SENSORS
@@ -53,18 +52,10 @@ class Agent:
     name: str
     robot: Robot
     profile: RobotProfile
-    sensors: dict[str, Any]          # port name -> the sensor (SmartCamera, Laser, ...)
+    sensors: dict[str, Any]          # port name -> the sensor (a SmartCamera, a Laser, ...)
     rates: dict[str, float]          # Hz of sim time by rate key (ODOM and each port's name); 0 = never
     first: bool                      # the first agent uses the plain topic names
     next_due: dict[str, float] = field(default_factory=dict)
-
-    @property
-    def camera(self) -> SmartCamera:
-        return self.sensors["camera"]
-
-    @property
-    def laser(self) -> Laser:
-        return self.sensors["scan"]
 
 
 class SimRuntime:
@@ -290,5 +281,8 @@ class SimRuntime:
 
     def close(self) -> None:
         for agent in self.agents:
-            agent.camera.close()
+            for sensor in agent.sensors.values():
+                close = getattr(sensor, "close", None)     # sensors that hold resources (GL objects)
+                if close is not None:
+                    close()
         self.world.close()
