@@ -5,7 +5,6 @@ import numpy as np
 import pytest
 
 from ravh_msgs_py import names as n
-from ravh_sim.dataset import layout
 from ravh_sim.dataset.api import Dataset
 from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
@@ -13,7 +12,7 @@ from ravh_sim.nodes import convert
 from ravh_sim.runtime import ODOM, SimRuntime
 from ravh_sim.sensors.ports import noise_rng
 from ravh_sim.sensors.readings import CameraInfo, Scan
-from ravh_sim.sensors.suite import SENSORS
+from ravh_sim.sensors.suite import SENSORS, capture_files
 
 EXPECTED_FIRST_DRAW = 1507402568       # numpy SeedSequence([5, 1, crc32("robot"), 0])
 
@@ -26,7 +25,9 @@ def runtime():
 
 
 def test_the_suite_is_well_formed():
-    assert [p.name for p in SENSORS] == ["scan", "camera"]
+    assert [p.name for p in SENSORS] == ["camera", "scan"]
+    kinds = [kind for p in SENSORS for kind in p.files]
+    assert len(kinds) == len(set(kinds)) and all(ext.startswith(".") for p in SENSORS for ext in p.files.values())
     keys = [t.key for p in SENSORS for t in p.topics]
     assert len(keys) == len(set(keys))                                  # publishers are indexed by key
     assert {t.kind for p in SENSORS for t in p.topics} <= set(convert.KINDS)
@@ -36,8 +37,8 @@ def test_the_suite_is_well_formed():
 
 def test_rates_come_from_the_robot_profile(runtime):
     agent = runtime.agents[0]
-    assert agent.rates == {ODOM: agent.profile.odom_rate, "scan": agent.profile.laser.rate,
-                           "camera": agent.profile.camera.rate}
+    assert agent.rates == {ODOM: agent.profile.odom_rate, "camera": agent.profile.camera.rate,
+                           "scan": agent.profile.laser.rate}
     assert all(port.rate(agent.profile) > 0 for port in SENSORS)
 
 
@@ -45,7 +46,7 @@ def test_rate_overrides_apply_on_top_and_unknown_rates_are_refused():
     rt = SimRuntime(20, renderer="tiny", rates={"camera": 0.0, ODOM: 25.0})
     try:
         agent = rt.agents[0]
-        assert agent.rates == {ODOM: 25.0, "scan": agent.profile.laser.rate, "camera": 0.0}
+        assert agent.rates == {ODOM: 25.0, "camera": 0.0, "scan": agent.profile.laser.rate}
         due = {"camera": 0, ODOM: 0}
         for _ in range(240):                                            # one sim second
             rt.step()
@@ -83,14 +84,16 @@ def test_each_port_reads_data_of_the_declared_shape(runtime):
 
 def test_mounts_are_every_sensor_frame_on_base_link(runtime):
     children = [child for _, child, _, _ in runtime.static_transforms(runtime.agents[0])]
-    assert children == [n.LASER_FRAME, n.CAMERA_FRAME, n.CAMERA_OPTICAL_FRAME]
+    assert children == [n.CAMERA_FRAME, n.CAMERA_OPTICAL_FRAME, n.LASER_FRAME]
     assert {port.frame for port in SENSORS} <= set(children)
 
 
-def test_stored_files_are_the_layout(runtime):
+def test_each_port_stores_the_files_it_declares(runtime):
     _, values = runtime.sample(runtime.agents[0])
-    kinds = [kind for port in SENSORS for kind in port.store(values).files]
-    assert sorted(kinds) == sorted(layout.CAPTURE_FILES)
+    for port in SENSORS:
+        assert set(port.store(values).files) == set(port.files)
+    assert capture_files(7) == {"rgb": "rgb/000007.png", "depth": "depth/000007.png", "mask": "mask/000007.png",
+                                "scan": "scan/000007.npy"}                     # the dataset README's layout
 
 
 def test_a_sample_round_trips_through_a_dataset_and_through_the_topics(runtime, tmp_path):
@@ -112,8 +115,7 @@ def test_a_sample_round_trips_through_a_dataset_and_through_the_topics(runtime, 
             w.write_footprint(runtime.footprint())
             w.write_meta(runtime.house.number, [agent.name])
             assert w.write_capture(event, vals) == 0
-    for kind in layout.CAPTURE_FILES:
-        path = layout.capture_files(0)[kind]
+    for kind, path in capture_files(0).items():
         assert (tmp_path / "direct" / path).read_bytes() == (tmp_path / "ros" / path).read_bytes(), kind
     ds = Dataset(tmp_path / "direct")
     sample = ds[0]

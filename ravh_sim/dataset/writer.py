@@ -22,7 +22,7 @@ from ravh_sim.dataset import layout
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.mapio import write_map
-from ravh_sim.sensors.suite import SENSORS
+from ravh_sim.sensors.suite import SENSORS, capture_files
 from ravh_sim.world.footprint import dump_footprint
 
 
@@ -39,8 +39,8 @@ class DatasetWriter:
                 self._rows = open(self.dir / layout.CAPTURES_JSONL, "x", encoding="utf-8")
             except FileExistsError:
                 raise UserError(f"{self.dir} already holds {layout.CAPTURES_JSONL}; record into a new folder") from None
-            for folder, _ in layout.CAPTURE_FILES.values():
-                (self.dir / folder).mkdir(exist_ok=True)
+            for kind in capture_files(0):
+                (self.dir / kind).mkdir(exist_ok=True)
         except OSError as e:
             raise UserError(f"{e.filename or self.dir}: cannot write the dataset: {e.strerror}") from None
         self.count = 0
@@ -86,7 +86,7 @@ class DatasetWriter:
         sensor port turns its own into files and fields.
         """
         index = self.count
-        files = layout.capture_files(index)
+        files = capture_files(index)
         room = event.room
         row: dict[str, Any] = {"index": index, "stamp": float(event.stamp), "agent": event.agent,
                                "pose": [float(v) for v in event.pose], "odom": [float(v) for v in event.odom],
@@ -95,8 +95,8 @@ class DatasetWriter:
         stored = [port.store(values) for port in SENSORS]
         contents = {kind: data for part in stored for kind, data in part.files.items()}
         if contents.keys() != files.keys():
-            raise ValueError(f"the sensors stored files {sorted(contents)}, the layout has {sorted(files)}")
-        for kind, path in files.items():                   # in the layout's order (README)
+            raise ValueError(f"the sensors stored files {sorted(contents)}, they declare {sorted(files)}")
+        for kind, path in files.items():
             layout.atomic_write(self.dir / path, contents[kind])
         for part in stored:
             row.update(part.row)

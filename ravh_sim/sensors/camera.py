@@ -308,5 +308,5 @@ PORT = SensorPort(
         Topic("instance", names.INSTANCE_IMAGE, "16UC1", dataset=True, bag=True,
               value=lambda cap, cam, frame: cap.instance.astype(np.uint16)),
     ),
-    rate=lambda profile: profile.camera.rate, mounts=_mounts,
+    files={"rgb": ".png", "depth": ".png", "mask": ".png"}, rate=lambda profile: profile.camera.rate, mounts=_mounts,
     build=_build, read=_read, store=_store)

@@ -124,5 +124,5 @@ def _read(laser: Laser, robot: Robot) -> Scan:
 PORT = SensorPort(
     name="scan", frame=names.LASER_FRAME, captured=False,
     topics=(Topic("scan", names.SCAN, "laser_scan", dataset=True, bag=True, value=lambda scan, laser, frame: scan),),
-    rate=lambda profile: profile.laser.rate, mounts=_mounts,
+    files={"scan": ".npy"}, rate=lambda profile: profile.laser.rate, mounts=_mounts,
     build=lambda world, profile, agent: Laser(world, profile.laser, agent), read=_read, store=_store)

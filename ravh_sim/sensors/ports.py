@@ -41,7 +41,7 @@ class Topic:
 @dataclass(frozen=True)
 class Stored:
     """What one sensor adds to a dataset sample (see ravh_sim/dataset/README.md)."""
-    files: dict[str, bytes]                                   # file kind (layout.CAPTURE_FILES) -> bytes
+    files: dict[str, bytes]                                   # file kind (SensorPort.files) -> bytes
     row: dict[str, Any] = field(default_factory=dict)         # fields of the sample's captures.jsonl line
     agent_facts: dict[str, Any] = field(default_factory=dict)  # side file (camera.json) -> this agent's entry
 
@@ -53,6 +53,7 @@ class SensorPort:
     frame: str                                       # the frame its data is stamped in (ravh_msgs_py.names)
     captured: bool                                   # recorded only for requested captures (else streamed)
     topics: tuple[Topic, ...]
+    files: dict[str, str]                            # its files in a dataset sample: kind (folder) -> extension
     rate: Callable[[RobotProfile], float]            # Hz of sim time
     mounts: Callable[[RobotProfile], list[Mount]]    # its frames on base_link (floor level)
     build: Callable[[World, RobotProfile, str], Any]  # (world, profile, agent name) -> the sensor
