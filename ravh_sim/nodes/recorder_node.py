@@ -11,12 +11,12 @@ ravh_sim.nodes.convert and stored by the ports through the DatasetWriter. Events
 different topics in any order, so parts wait by stamp in :class:`StampMatcher` until the set is
 complete; periodic camera frames never get an event and are dropped unrecorded. The bag keeps the
 continuous streams (scan, odom, ground-truth pose, capture events, /tf) whole, the latched ones (/map,
-/tf_static, /ravh/ground_truth, instance labels) with transient-local QoS so ``ros2 bag play`` re-
-latches them, and of the camera only the captures (JPEG colour, depth, instances, camera_infos), so bag
-and dataset describe the same frames. Bag times are sim receive times (``use_sim_time``); messages that
-arrive before the first /clock are written at the first clock time. SIGINT closes the bag (metadata.yaml
-written); a SIGKILLed recorder leaves a dataset that reads back complete up to its last capture, and an
-MCAP without its summary (``mcap recover`` rebuilds it).
+/tf_static, /ravh/ground_truth, instance labels) with transient-local QoS so ``ros2 bag play``
+re-latches them, and of the camera only the captures (JPEG colour, depth, instances, camera_infos), so
+bag and dataset describe the same frames. Bag times are sim receive times (``use_sim_time``); messages
+that arrive before the first /clock are written at the first clock time. SIGINT closes the bag
+(metadata.yaml written); a SIGKILLed recorder leaves a dataset that reads back complete up to its last
+capture, and an MCAP without its summary (``mcap recover`` rebuilds it).
 
 Nothing is lost silently: each stored capture is confirmed on ``ravh/capture_recorded`` (reliable,
 keep-all), which a behaviour run with ``--wait-recorder`` waits for before it moves on; a capture that
