@@ -234,3 +234,14 @@ def test_a_bad_map_tf_is_a_one_line_error():
                           "map_tf:=bogus"], capture_output=True, text=True, env=ros_env(), timeout=120)
     assert out.returncode == 2 and "map_tf must be one of auto, on, off, got 'bogus'" in out.stderr
     assert "Traceback" not in out.stderr
+
+
+def test_a_negative_rate_is_a_one_line_error():
+    import subprocess
+    import sys
+
+    from rosgraph import ros_env
+    out = subprocess.run([sys.executable, "-m", "ravh_sim.cli", "sim", "--house", "20", "--scan-rate", "-5"],
+                         capture_output=True, text=True, env=ros_env(), timeout=120)
+    assert out.returncode == 2 and "scan_rate must be >= 0 Hz (0 = never), got -5.0" in out.stderr
+    assert "Traceback" not in out.stderr

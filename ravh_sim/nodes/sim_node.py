@@ -67,7 +67,8 @@ MAP_TF_RESUME_S = 2.0                   # wall s without another map -> odom pub
 TF_LISTEN_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT)
 
 FROM_PROFILE = -1.0                     # a rate parameter's default: each agent's robot profile says
-RATE_PARAMETERS = {"camera_rate": "camera", "scan_rate": "scan", "odom_rate": ODOM}   # parameter -> rate key
+# parameter -> rate key: camera_rate, scan_rate (one per sensor port) and odom_rate
+RATE_PARAMETERS = {f"{key}_rate": key for key in (*(port.name for port in SENSORS), ODOM)}
 PARAMETERS: dict[str, Any] = {
     "house": 15, "seed": -1, "config": "", "footprint": "", "renderer": "auto", "real_time_factor": 1.0,
     **dict.fromkeys(RATE_PARAMETERS, FROM_PROFILE), "clock_rate": 100.0,
@@ -433,8 +434,8 @@ def parse_args(argv: list[str]) -> dict[str, Any]:
     p.add_argument("--renderer", choices=BACKENDS)
     p.add_argument("--rtf", "--real-time-factor", dest="real_time_factor", type=float,
                    help="sim seconds per wall second; 0 = as fast as possible (default 1)")
-    for flag, param in (("--camera-rate", "camera_rate"), ("--scan-rate", "scan_rate"), ("--odom-rate", "odom_rate")):
-        p.add_argument(flag, dest=param, type=float,
+    for param in RATE_PARAMETERS:
+        p.add_argument("--" + param.replace("_", "-"), dest=param, type=float,
                        help="Hz of sim time for every agent (default: its robot profile's; 0 = never)")
     p.add_argument("--cmd-vel-stamped", dest="cmd_vel_stamped", action="store_true", default=None)
     p.add_argument("--map-tf", dest="map_tf", choices=MAP_TF_MODES,
