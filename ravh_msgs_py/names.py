@@ -19,6 +19,12 @@ heights.
 """
 from __future__ import annotations
 
+from typing import Any
+
+# ---------------------------------------------------------------- defaults
+DEFAULT_AGENT = "robot"                            # the agent of the default settings (config/default.yaml)
+DEFAULT_PROFILE = "giraff"                         # the robot profile an agent gets unless told (config/robots/)
+
 # ---------------------------------------------------------------- frames (REP 105 / REP 103)
 MAP_FRAME = "map"
 ODOM_FRAME = "odom"
@@ -73,3 +79,9 @@ def agent_name(base: str, agent: str, first: bool) -> str:
     if first or base.startswith("/"):
         return base
     return f"{agent}/{base}"
+
+
+def footprint_agents(footprint: dict[str, Any]) -> list[str]:
+    """The agents' names in the sim's order, from the footprint on /ravh/ground_truth: the first of them
+    uses the plain names, whatever it is called."""
+    return [str(a["name"]) for a in footprint.get("settings", {}).get("agents", [])]

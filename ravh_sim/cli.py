@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from ravh_msgs_py.appearance import DOOR, SWITCH
+from ravh_msgs_py.names import DEFAULT_PROFILE
 from ravh_sim.bench import BENCHES
 from ravh_sim.dataset.build import add_parser as add_dataset_parser
 from ravh_sim.errors import UserError
@@ -131,7 +132,7 @@ def cmd_map(args: argparse.Namespace) -> int:
     if args.doors:
         settings["doors"] = {"all": args.doors, "set": {}}
     resolved = resolve(settings, house, args.seed, str(args.config or "config/default.yaml"))
-    profile = load_profile(args.profile or (resolved.agents[0].profile if resolved.agents else "giraff"))
+    profile = load_profile(args.profile or (resolved.agents[0].profile if resolved.agents else DEFAULT_PROFILE))
     navigation = Navigation(house, WorldState(resolved), profile, args.resolution)
     pgm, yaml_path = navigation.write_map(args.output, args.inflated)
     print(f"wrote {pgm} and {yaml_path}")
@@ -285,7 +286,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--lights", choices=SWITCH, default=None,
                    help="switch every light (default: config); random uses --seed")
     p.add_argument("--renderer", choices=BACKENDS, default="auto")
-    p.add_argument("--profile", default="giraff", help="robot profile for the camera (default: giraff)")
+    p.add_argument("--profile", default=DEFAULT_PROFILE,
+                   help=f"robot profile for the camera (default: {DEFAULT_PROFILE})")
     p.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     p.set_defaults(func=cmd_render)
 

@@ -1,32 +1,36 @@
 """The simulator without ROS: one house, its robots and sensors on one sim clock.
 
 :class:`SimRuntime` is what the sim node wraps: it builds the World from a house and settings, keeps
-the Simulation (physics + agents), each agent's camera and laser, the Navigation Manager and the
-ground truth, and says which sensors are due at the current sim time. Everything here is plain
+the Simulation (physics + agents), each agent's sensors (one per port of
+:data:`~ravh_sim.sensors.suite.SENSORS`), the Navigation Manager and the ground truth, and says which
+sensors are due at the current sim time (rates from each agent's robot profile). Everything here is plain
 Python, so the whole data path (house file -> World -> sensors) is tested without a ROS graph, and the
 node only converts and publishes.
 """
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from ravh_msgs_py import appearance as appearance_lang
 from ravh_msgs_py import names
+from ravh_msgs_py.capture import CaptureEvent
 from ravh_msgs_py.query import BAD_REQUEST, INTERNAL, MAX_COORDINATE, QueryError, error_reply, ok_reply
 from ravh_sim.errors import UserError
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.nav.planner import Path as PlannedPath
-from ravh_sim.poses import compose, quaternion_from_matrix, relative
+from ravh_sim.poses import compose, relative
 from ravh_sim.robot.profile import RobotProfile, load_profile
 from ravh_sim.robot.robot import Robot
 from ravh_sim.robot.simulation import Simulation
 from ravh_sim.schema import shown
-from ravh_sim.sensors.camera import CameraOptions, Capture, SmartCamera
-from ravh_sim.sensors.laser import Laser, Scan
-from ravh_sim.sensors.mount import LINK_TO_OPTICAL, mount_position, mount_rotation
+from ravh_sim.sensors.camera import Capture
+from ravh_sim.sensors.ports import Mount
+from ravh_sim.sensors.readings import Scan
+from ravh_sim.sensors.suite import SENSORS
 from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import load_footprint, make_footprint
 from ravh_sim.world.ground_truth import GroundTruth
@@ -34,22 +38,12 @@ from ravh_sim.world.house import House, load_house
 from ravh_sim.world.scene import World
 from ravh_sim.world.settings import load_settings, resolve
 
-# camera_link (x forward, z up) -> optical frame (z forward, x right, y down), REP 103
-OPTICAL_ROTATION = quaternion_from_matrix(LINK_TO_OPTICAL)
-
 # Commands beyond these magnitudes are refused as nonsense rather than clamped (clamping a
 # 1e9 m/s command would hide a unit bug in the sender); smaller overshoots are clamped by the robot.
 ABSURD_LINEAR = 10.0      # m/s
 ABSURD_ANGULAR = 20.0     # rad/s
-
-
-@dataclass
-class Rates:
-    """Sensor and state rates in Hz of sim time."""
-    camera: float = 10.0
-    scan: float = 10.0
-    odom: float = 50.0
-    clock: float = 100.0
+ODOM = "odom"             # the rate key of odometry, the true pose and /tf (a sensor's key is its port's name)
+PORTS = {port.name: port for port in SENSORS}
 
 
 @dataclass
@@ -57,8 +51,8 @@ class Agent:
     name: str
     robot: Robot
     profile: RobotProfile
-    camera: SmartCamera
-    laser: Laser
+    sensors: dict[str, Any]          # port name -> the sensor (a SmartCamera, a Laser, ...)
+    rates: dict[str, float]          # Hz of sim time by rate key (ODOM and each port's name); 0 = never
     first: bool                      # the first agent uses the plain topic names
     next_due: dict[str, float] = field(default_factory=dict)
 
@@ -67,10 +61,14 @@ class SimRuntime:
     """A running house: physics, agents, sensors, appearance, navigation and ground truth."""
 
     def __init__(self, house: int | House, config: str | Path | None = None, seed: int | None = None,
-                 renderer: str = "auto", rates: Rates | None = None,
+                 renderer: str = "auto", rates: Mapping[str, float] | None = None,
                  footprint: str | Path | None = None) -> None:
         """``footprint``: rebuild exactly the world a footprint file describes (its house and its
-        resolved settings); ``house``, ``config`` and ``seed`` are then ignored."""
+        resolved settings); ``house``, ``config`` and ``seed`` are then ignored. ``rates``: Hz by rate
+        key (ODOM, a port's name) for every agent, over those of its robot profile."""
+        unknown = set(rates or {}) - {ODOM, *PORTS}
+        if unknown:
+            raise UserError(f"unknown rate {', '.join(sorted(unknown))}; valid: {', '.join([ODOM, *PORTS])}")
         if footprint:
             number, resolved = load_footprint(Path(footprint))
             self.house = load_house(number)
@@ -81,17 +79,15 @@ class SimRuntime:
         self.world = World(self.house, resolved, renderer=renderer)
         self.appearance = Appearance(self.world)
         self.sim = Simulation(self.world)
-        self.rates = rates or Rates()
         self.agents = []
         for i, spec in enumerate(resolved.agents):
             profile = load_profile(spec.profile)
-            robot = self.sim.robot(spec.name)
-            self.agents.append(Agent(spec.name, robot, profile,
-                                     SmartCamera(self.world, profile.camera,
-                                                 CameraOptions(**dict(profile.camera_effects))),
-                                     Laser(self.world, profile.laser), i == 0))
+            sensors = {port.name: port.build(self.world, profile, spec.name) for port in SENSORS}
+            own = {ODOM: profile.odom_rate, **{port.name: port.rate(profile) for port in SENSORS}}
+            self.agents.append(Agent(spec.name, self.sim.robot(spec.name), profile, sensors,
+                                     {**own, **(rates or {})}, i == 0))
         self.navigation = Navigation(self.house, self.world.state, self.agents[0].profile
-                                     if self.agents else load_profile("giraff"))
+                                     if self.agents else load_profile(names.DEFAULT_PROFILE))
         self.ground_truth = GroundTruth(self.house, self.world.state)
 
     @property
@@ -108,8 +104,9 @@ class SimRuntime:
         self.sim.step(n)
 
     def due(self, agent: Agent, what: str) -> bool:
-        """True (and schedules the next one) when ``what`` (camera, scan, odom) is due for ``agent``."""
-        rate = getattr(self.rates, what)
+        """True (and schedules the next one) when ``what`` (a rate key: ODOM or a port's name) is due
+        for ``agent``."""
+        rate = agent.rates[what]
         if rate <= 0:
             return False
         t = self.time
@@ -121,30 +118,36 @@ class SimRuntime:
         return True
 
     # ------------------------------------------------------------------ sensing
+    def read(self, agent: Agent, port: str) -> Any:
+        """The data of ``agent``'s sensor of port ``port`` now (a Capture, a Scan, ...)."""
+        return PORTS[port].read(agent.sensors[port], agent.robot)
+
     def capture(self, agent: Agent) -> Capture:
-        x, y, yaw = agent.robot.pose
-        return agent.camera.capture(x, y, yaw, velocity=agent.robot.velocity)
+        return self.read(agent, "camera")
 
     def scan(self, agent: Agent) -> Scan:
-        x, y, yaw = agent.robot.pose
-        return agent.laser.scan(x, y, yaw, ignore_bodies=(agent.robot.body,))
+        return self.read(agent, "scan")
+
+    def sample(self, agent: Agent) -> tuple[CaptureEvent, dict[str, Any]]:
+        """One synchronised capture as a dataset sample: its event and every sensor's dataset values
+        by topic key, the values the recorder decodes from the topics (frames named as published)."""
+        values: dict[str, Any] = {}
+        for port in SENSORS:
+            data, frame = self.read(agent, port.name), names.agent_name(port.frame, agent.name, agent.first)
+            values.update({t.key: t.value(data, agent.sensors[port.name], frame) for t in port.topics if t.dataset})
+        return self.capture_event(agent), values
+
+    def capture_event(self, agent: Agent) -> CaptureEvent:
+        """What ``ravh/capture`` says about a capture taken now: where the agent stands, truly and by odometry."""
+        return CaptureEvent(agent.name, self.time, agent.robot.pose, self.room_of(agent), agent.robot.odometry)
 
     def map_to_odom(self, agent: Agent) -> tuple[float, float, float]:
         """The map -> odom transform: where odometry's origin lies given its drift so far."""
         return compose(agent.robot.pose, relative(agent.robot.odometry, (0.0, 0.0, 0.0)))
 
-    def static_transforms(self, agent: Agent) -> list[tuple[str, str, tuple, tuple]]:
-        """(parent, child, xyz, quaternion xyzw) of the sensor mounts on base_link (at floor level),
-        from the same mount functions the camera and laser render with, so TF and images agree."""
-        cam, laser = agent.profile.camera, agent.profile.laser
-        camera_xyz = mount_position(0.0, 0.0, 0.0, 0.0, cam.height, cam.forward)
-        return [
-            (names.BASE_FRAME, names.LASER_FRAME, tuple(mount_position(0.0, 0.0, 0.0, 0.0, laser.height)),
-             quaternion_from_matrix(mount_rotation(0.0))),
-            (names.BASE_FRAME, names.CAMERA_FRAME, tuple(camera_xyz),
-             quaternion_from_matrix(mount_rotation(0.0, math.radians(cam.pitch_deg)))),
-            (names.CAMERA_FRAME, names.CAMERA_OPTICAL_FRAME, (0.0, 0.0, 0.0), OPTICAL_ROTATION),
-        ]
+    def static_transforms(self, agent: Agent) -> list[Mount]:
+        """(parent, child, xyz, quaternion xyzw) of every sensor mount on base_link (at floor level)."""
+        return [mount for port in SENSORS for mount in port.mounts(agent.profile)]
 
     def room_of(self, agent: Agent) -> str | None:
         room = self.house.room_at(*agent.robot.pose[:2])
@@ -197,5 +200,8 @@ class SimRuntime:
 
     def close(self) -> None:
         for agent in self.agents:
-            agent.camera.close()
+            for sensor in agent.sensors.values():
+                close = getattr(sensor, "close", None)     # sensors that hold resources (GL objects)
+                if close is not None:
+                    close()
         self.world.close()

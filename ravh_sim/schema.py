@@ -32,10 +32,14 @@ def _finite(v: float) -> float:
     return v
 
 
+FINITE = AfterValidator(_finite)     # in Annotated[float, Field(...), FINITE], what number() returns, spelled out
+                                     # where a type checker must read the annotation
+
+
 def number(ge: float | None = None, le: float | None = None, gt: float | None = None,
            lt: float | None = None) -> Any:
     """A finite float field with bounds; strict floats take ints (YAML/JSON write 1 for 1.0), not bools."""
-    return Annotated[float, Field(ge=ge, le=le, gt=gt, lt=lt), AfterValidator(_finite)]
+    return Annotated[float, Field(ge=ge, le=le, gt=gt, lt=lt), FINITE]
 
 
 def vector(item: Any, n: int) -> Any:

@@ -17,20 +17,25 @@ from conftest import resolved
 from rosgraph import NodeProcess, remove_orphan_shm, spin_until, start_rclpy
 
 from ravh_msgs_py import names as n
+from ravh_msgs_py.capture import CaptureEvent
 from ravh_sim.dataset import layout
 from ravh_sim.dataset.api import MIN_PIXELS, Dataset
 from ravh_sim.dataset.summary import render_summary, write_summary
 from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid
+from ravh_sim.nodes import convert
 from ravh_sim.sensors import imaging
+from ravh_sim.sensors.readings import CameraInfo, Scan
+from ravh_sim.sensors.suite import capture_files
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.house import load_house
 
 H, W = 48, 64
-SCAN_META = {"angle_min": -math.pi, "angle_increment": math.radians(1.0), "range_min": 0.05, "range_max": 30.0}
 CAMERA = {"width": W, "height": H, "K": [50.0, 0, 32, 0, 50.0, 24, 0, 0, 1], "D": [0.0] * 5,
           "distortion_model": "plumb_bob", "frame_id": "camera_optical_frame"}
+INFO = CameraInfo(CAMERA["frame_id"], W, H, "plumb_bob", tuple(CAMERA["D"]), tuple(CAMERA["K"]),
+                  tuple(np.eye(3).ravel()), (50.0, 0, 32, 0, 0, 50.0, 24, 0, 0, 0, 1, 0))
 
 
 def footprint_of(number: int) -> dict:
@@ -58,7 +63,12 @@ def capture(rng: np.random.Generator, ids: list[int]) -> dict:
     ranges = rng.uniform(0.1, 10.0, 360).astype(np.float32)
     ranges[:3] = [np.inf, np.nan, 0.01]
     return {"rgb": rng.integers(0, 256, (H, W, 3), dtype=np.uint8), "depth": depth, "instance": instance,
-            "scan_ranges": ranges}
+            "rgb_info": INFO, "scan": Scan("laser_link", -math.pi, math.radians(179), math.radians(1.0), 0.0, 0.1,
+                                           0.05, 30.0, ranges)}
+
+
+def event(stamp: float, room: str | None, pose=(0.0, 0.0, 0.0), odom=(0.0, 0.0, 0.0)) -> CaptureEvent:
+    return CaptureEvent("robot", stamp, tuple(pose), room, tuple(odom))
 
 
 def write_dataset(root: Path, footprint: dict, poses: list[tuple[str | None, tuple[float, float, float]]],
@@ -77,8 +87,7 @@ def write_dataset(root: Path, footprint: dict, poses: list[tuple[str | None, tup
         for k, (room, pose) in enumerate(poses):
             ids = [r["id"] for r in objects if r["room"] == room][:6] if room else []
             arrays = capture(rng, ids)
-            index = w.write_capture(10.0 + k, "robot", pose, (pose[0] + 0.1, pose[1], pose[2]), room, **arrays,
-                                    scan_meta=SCAN_META, camera=CAMERA)
+            index = w.write_capture(event(10.0 + k, room, pose, (pose[0] + 0.1, pose[1], pose[2])), arrays)
             assert index == k
             written.append(arrays)
     return written
@@ -115,7 +124,7 @@ def test_round_trip(tmp_path, footprint20):
         assert np.array_equal(np.isnan(sample.depth), invalid)
         assert np.abs(sample.depth[~invalid] - arrays["depth"][~invalid]).max() <= 0.0005 + 1e-6
         scan = sample.scan
-        assert np.array_equal(scan.ranges, arrays["scan_ranges"], equal_nan=True)
+        assert np.array_equal(scan.ranges, arrays["scan"].ranges, equal_nan=True)
         assert scan.angles[0] == pytest.approx(-math.pi) and scan.angles[-1] == pytest.approx(math.radians(179))
         assert (scan.range_min, scan.range_max) == (pytest.approx(0.05), 30.0)
     mask = ds[0].mask
@@ -146,12 +155,10 @@ def test_a_crash_between_files_leaves_no_half_capture(tmp_path, footprint20, mon
     writer = DatasetWriter(tmp_path / "a")
     writer.write_footprint(footprint20)
     writer.write_meta(20, ["robot"])
-    writer.write_capture(1.0, "robot", (0, 0, 0), (0, 0, 0), room, **capture(np.random.default_rng(1), []),
-                         scan_meta=SCAN_META)
+    writer.write_capture(event(1.0, room), capture(np.random.default_rng(1), []))
     monkeypatch.setattr(layout, "atomic_write", dying_write)
     with pytest.raises(KeyboardInterrupt):
-        writer.write_capture(2.0, "robot", (0, 0, 0), (0, 0, 0), room, **capture(np.random.default_rng(2), []),
-                             scan_meta=SCAN_META)
+        writer.write_capture(event(2.0, room), capture(np.random.default_rng(2), []))
     a = tmp_path / "a"
     assert (a / "rgb/000001.png").exists() and (a / "depth/000001.png").exists()
     assert not (a / "mask/000001.png").exists() and (a / "mask/.000001.png.1.tmp").exists()
@@ -211,7 +218,7 @@ def test_objects_in_counts_visible_instances_by_type(tmp_path, footprint20):
         w.write_meta(20, ["robot"])
         arrays = capture(np.random.default_rng(0), [chairs[0]["id"], chairs[1]["id"], other["id"], door["id"]])
         arrays["instance"][-1, :MIN_PIXELS - 1] = tiny["id"]          # too small to count
-        w.write_capture(1.0, "robot", (0, 0, 0), (0, 0, 0), chairs[0]["room"], **arrays, scan_meta=SCAN_META)
+        w.write_capture(event(1.0, chairs[0]["room"]), arrays)
     ds = Dataset(ds_writer_root)
     assert ds.objects_in(ds[0]) == Counter({"Chair": 2, other["type"]: 1})
     assert ds.objects_in(ds[0], min_pixels=1)[tiny["type"]] == 1
@@ -285,7 +292,6 @@ def test_stamps_from_cdr_and_events_agree():
     from rclpy.serialization import serialize_message
     from sensor_msgs.msg import LaserScan
 
-    from ravh_sim.nodes import convert
     for seconds in (0.0, 353.6, 12.345678901, 1e6 + 0.1):
         data = serialize_message(LaserScan(header=convert.header(seconds, "laser_link")))
         assert rec.header_stamp_ns(data) == rec.event_stamp_ns(seconds)
@@ -319,14 +325,14 @@ def start_recorder(sim, out: Path, *args: str) -> NodeProcess:
     return rec
 
 
-def request_capture(sim) -> dict:
+def request_capture(sim) -> CaptureEvent:
     import rclpy
     from std_srvs.srv import Trigger
     _, node, client = sim
     future = client.call_async(Trigger.Request())
     rclpy.spin_until_future_complete(node, future, timeout_sec=20)
     assert future.done() and future.result().success
-    return json.loads(future.result().message)
+    return CaptureEvent.from_json(future.result().message)
 
 
 def rows(out: Path) -> int:
@@ -350,8 +356,8 @@ def test_recorder_writes_captures_and_a_bag(sim, tmp_path):
     assert ds.camera["robot"]["width"] == 640 and ds.camera["robot"]["frame_id"] == n.CAMERA_OPTICAL_FRAME
     room_types = rooms_of(ds.footprint)
     for sample, event in zip(ds, events):
-        assert sample.stamp == event["stamp"] and sample.pose == pytest.approx(event["pose"])
-        assert sample.room == event["room"] and sample.room_type == room_types.get(event["room"])
+        assert sample.stamp == event.stamp and sample.pose == pytest.approx(event.pose)
+        assert sample.room == event.room and sample.room_type == room_types.get(event.room)
         assert sample.rgb.shape == (480, 640, 3) and sample.instance.shape == (480, 640)
         assert np.isfinite(sample.depth).mean() > 0.5 and len(sample.scan.ranges) == 360
         ids = set(np.unique(sample.instance).tolist()) - {0}
@@ -375,8 +381,9 @@ def test_recorder_writes_captures_and_a_bag(sim, tmp_path):
         depth_conn = [c for c in bag.connections if c.topic == "/" + n.DEPTH_IMAGE]
         msgs = [typestore.deserialize_cdr(raw, c.msgtype) for c, _, raw in bag.messages(connections=depth_conn)]
     first = min(msgs, key=lambda m: (m.header.stamp.sec, m.header.stamp.nanosec))
-    assert first.header.stamp.sec + first.header.stamp.nanosec * 1e-9 == pytest.approx(ds[0].stamp)
-    depth = np.frombuffer(first.data, np.float32).reshape(480, 640)
+    assert convert.seconds(first.header.stamp) == pytest.approx(ds[0].stamp)
+    depth = convert.image_array(first)                       # a rosbags message: the same fields
+    assert depth.shape == (480, 640)
     valid = np.isfinite(depth)
     assert np.array_equal(valid, np.isfinite(ds[0].depth))
     assert np.abs(depth[valid] - ds[0].depth[valid]).max() <= 0.0005 + 1e-6
@@ -389,7 +396,7 @@ def test_a_killed_recorder_leaves_a_consistent_dataset(sim, tmp_path):
         request_capture(sim)
     assert spin_until(sim[1], lambda: rows(out) == 3, 30), rec.log()[-3000:]
     request_capture(sim)
-    first_file = out / layout.capture_files(3)["rgb"]
+    first_file = out / capture_files(3)["rgb"]
     end = time.monotonic() + 20
     while not first_file.exists() and time.monotonic() < end:   # kill it while it writes capture 3
         time.sleep(0.0005)
@@ -405,7 +412,7 @@ def test_a_killed_recorder_leaves_a_consistent_dataset(sim, tmp_path):
         assert sample.rgb.shape == (480, 640, 3) and sample.depth.shape == sample.instance.shape == (480, 640)
         assert len(sample.scan.ranges) == 360
     listed = {s.index for s in ds}
-    for kind, (folder, ext) in layout.CAPTURE_FILES.items():
-        on_disk = {int(p.stem) for p in (out / folder).glob(f"*{ext}")}
+    for kind, path in capture_files(0).items():
+        on_disk = {int(p.stem) for p in (out / kind).glob(f"*{Path(path).suffix}")}   # not torn temp files
         assert listed <= on_disk and len(on_disk - listed) <= 1, kind   # at most the in-flight capture
     assert not (out / layout.BAG_DIR / "metadata.yaml").exists()     # the bag was not closed

@@ -10,9 +10,8 @@ import pytest
 from ravh_msgs_py import appearance
 from ravh_msgs_py.query import QueryError
 from ravh_sim.errors import UserError
-from ravh_sim.nav.grid import Grid
-from ravh_sim.nodes import convert
-from ravh_sim.runtime import OPTICAL_ROTATION, SimRuntime
+from ravh_sim.runtime import SimRuntime
+from ravh_sim.sensors.camera import OPTICAL_ROTATION
 
 
 @pytest.fixture(scope="module")
@@ -110,39 +109,6 @@ def test_appearance_syntax_is_checked_offline():
         appearance.parse('{"models": {"Bed_0": -1}}')
 
 
-def test_image_conversion_round_trips():
-    rgb = np.random.default_rng(0).integers(0, 255, (4, 5, 3), dtype=np.uint8)
-    depth = np.linspace(0.5, 3, 20, dtype=np.float32).reshape(4, 5)
-    hdr = convert.header(12.25, "camera_optical_frame")
-    m = convert.image(rgb, "rgb8", hdr)
-    assert (m.width, m.height, m.step) == (5, 4, 15)
-    assert np.array_equal(np.frombuffer(m.data, np.uint8).reshape(4, 5, 3), rgb)
-    d = convert.image(depth, "32FC1", hdr)
-    assert np.array_equal(np.frombuffer(d.data, np.float32).reshape(4, 5), depth) and d.step == 20
-    assert (m.header.stamp.sec, m.header.stamp.nanosec) == (12, 250_000_000)
-
-
-def test_laser_scan_counting_rule():
-    ranges = np.full(360, np.inf, np.float32)
-    msg = convert.laser_scan(ranges, -math.pi, math.radians(1), 0.05, 30.0, 0.1, convert.header(0, "laser"))
-    assert len(msg.ranges) == round((msg.angle_max - msg.angle_min) / msg.angle_increment) + 1
-    assert math.isinf(msg.ranges[0])
-
-
-def test_occupancy_grid_conversion():
-    grid = Grid(np.array([[0, 100], [-1, 0]], np.int8), (1.5, -2.0), 0.05)
-    msg = convert.occupancy_grid(grid, convert.header(0, "map"), 0.0)
-    assert list(msg.data) == [0, 100, -1, 0] and (msg.info.width, msg.info.height) == (2, 2)
-    assert (msg.info.origin.position.x, msg.info.origin.position.y) == (1.5, -2.0)
-
-
-def test_camera_info_has_k_and_p():
-    k = np.array([[548.6, 0, 320], [0, 568.4, 240], [0, 0, 1]])
-    info = convert.camera_info(k, 640, 480, convert.header(0, "cam"))
-    assert list(info.k) == k.ravel().tolist() and info.p[3] == 0.0 and info.p[0] == 548.6
-    assert info.distortion_model == "plumb_bob" and len(info.d) == 5
-
-
 def test_a_footprint_rebuilds_the_same_world(runtime, tmp_path):
     from ravh_sim.world.footprint import dump_footprint, write_footprint
     runtime.change_appearance({"models": {"Bed_0": 2}, "paint": {"Bedroom_1": {"walls": "brick"}}})
@@ -176,6 +142,13 @@ def test_profile_camera_effects_are_validated(tmp_path):
     good.write_text(yaml.safe_dump(data))
     effects = dict(load_profile(good).camera_effects)
     assert effects["pixel_noise"] == 3.0 and effects["distortion"] == (-0.1, 0.01, 0.0, 0.0, 0.0)
+    data["camera"]["effects"] = {"pixel_noise": None, "distortion": None}      # null: the camera's default
+    good.write_text(yaml.safe_dump(data))
+    assert dict(load_profile(good).camera_effects) == {}
+    data["camera"]["effects"] = {"distortion": [0.0, 0.0, 0.0, 0.0, 99.0]}
+    good.write_text(yaml.safe_dump(data))
+    with pytest.raises(FileFieldError, match="camera.effects.distortion"):
+        load_profile(good)
     data["camera"]["effects"] = {"sparkle": 1}
     bad = tmp_path / "bad.yaml"
     bad.write_text(yaml.safe_dump(data))

@@ -113,6 +113,8 @@ def _set(d: dict, dotted: str, value) -> None:
     ("camera.width", 0.5, "camera.width"),
     ("camera.width", 0, "camera.width"),
     ("camera.rate", float("nan"), "camera.rate"),
+    ("odometry.rate", 0, "odometry.rate"),
+    ("camera.effects.jpeg_roundtrip", "yes", "camera.effects.jpeg_roundtrip"),
     ("mass", "heavy", "mass"),
     ("camera.effects.blurr", True, "camera.effects.blurr"),
     ("wheels", 4, "wheels"),

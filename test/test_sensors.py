@@ -503,6 +503,21 @@ def test_same_seed_and_pose_give_identical_images_and_scans(box_house):
     assert not np.array_equal(a1.rgb, c1.rgb) and not np.array_equal(s1.ranges, u1.ranges)   # new seed
 
 
+def test_each_agent_has_its_own_noise(box_house):
+    """Same seed, pose and frame counter: one agent's sensors repeat exactly, two agents' differ."""
+    options = CameraOptions(pixel_noise=3.0, depth_noise=0.002)
+    laser_spec = replace(PROFILE.laser, noise_sigma=0.01)
+    with _world(box_house, "tiny", 5) as w:
+        reads = [(SmartCamera(w, PROFILE.camera, options, agent).capture(2.0, 2.0, 0.3),
+                  Laser(w, laser_spec, agent).scan(2.0, 2.0, 0.3)) for agent in ("alpha", "beta", "alpha")]
+    (a, sa), (b, sb), (a_again, sa_again) = reads
+    assert a.index == b.index == a_again.index == 0 and sa.index == sb.index == 0
+    assert np.array_equal(a.rgb, a_again.rgb) and np.array_equal(a.depth, a_again.depth, equal_nan=True)
+    assert np.array_equal(sa.ranges, sa_again.ranges)
+    assert not np.array_equal(a.rgb, b.rgb) and not np.array_equal(a.depth, b.depth, equal_nan=True)
+    assert not np.array_equal(sa.ranges, sb.ranges)
+
+
 def test_tiny_renderer_fallback_sees_the_same_geometry(box_house, camera):
     """The fallback looks plainer (no shadows, no materials) but sees the same scene from the same K."""
     pose = (3.0, 1.5, 0.3)

@@ -21,8 +21,10 @@ from std_msgs.msg import String  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
 from ravh_msgs_py import names as n  # noqa: E402
+from ravh_msgs_py.capture import CaptureEvent  # noqa: E402
 from ravh_msgs_py.client import RavhClient  # noqa: E402
-from ravh_sim.nav.grid import FREE, Grid  # noqa: E402
+from ravh_sim.nav.grid import FREE  # noqa: E402
+from ravh_sim.nodes import convert  # noqa: E402
 from ravh_sim.nodes.common import LATCHED_QOS, SENSOR_QOS, STATE_QOS  # noqa: E402
 
 HOUSE = "20"
@@ -47,8 +49,7 @@ RATES = {n.CLOCK: 100.0, n.SCAN: 10.0, n.COLOR_IMAGE: 10.0, n.DEPTH_IMAGE: 10.0,
 
 
 def stamp_s(msg) -> float:
-    s = msg.clock if isinstance(msg, Clock) else msg.header.stamp
-    return s.sec + s.nanosec * 1e-9
+    return convert.seconds(msg.clock if isinstance(msg, Clock) else msg.header.stamp)
 
 
 class Probe:
@@ -137,7 +138,8 @@ def test_camera_info_follows_the_papers_formula(sim):
 
 def test_depth_is_metres_and_scan_follows_rep117(sim):
     _, probe = sim
-    depth = np.frombuffer(probe.got[n.DEPTH_IMAGE][-1].data, np.float32).reshape(480, 640)
+    depth = convert.image_array(probe.got[n.DEPTH_IMAGE][-1])
+    assert depth.shape == (480, 640)
     valid = depth[np.isfinite(depth)]
     assert valid.size > 0.5 * depth.size and 0.05 < valid.min() and valid.max() < 25
     scan = probe.got[n.SCAN][-1]
@@ -156,28 +158,27 @@ def test_clock_advances(sim):
     assert all(b > a for a, b in zip(stamps, stamps[1:]))
 
 
-def _yaw(q) -> float:
-    return 2 * math.atan2(q.z, q.w)
-
-
 def test_cmd_vel_moves_the_robot(sim):
     _, probe = sim
-    gt0 = probe.got[n.GROUND_TRUTH_POSE][-1].pose.orientation
-    odom0 = probe.got[n.ODOM][-1].pose.pose.orientation
-    scan0 = np.array(probe.got[n.SCAN][-1].ranges)
+    gt0 = convert.pose_of(probe.got[n.GROUND_TRUTH_POSE][-1].pose)
+    odom0, _, _ = convert.odometry_of(probe.got[n.ODOM][-1])
+    scan0 = convert.scan_of(probe.got[n.SCAN][-1]).ranges
     turn = Twist()
     turn.angular.z = 0.4
 
-    def turned(q0, q) -> float:
-        return abs(math.remainder(_yaw(q) - _yaw(q0), 2 * math.pi))
+    def turned(p0, p) -> float:
+        return abs(math.remainder(p[2] - p0[2], 2 * math.pi))
+
+    def gt():
+        return convert.pose_of(probe.got[n.GROUND_TRUTH_POSE][-1].pose)
 
     end = time.monotonic() + 60                   # however long half a radian takes on this machine
-    while turned(gt0, probe.got[n.GROUND_TRUTH_POSE][-1].pose.orientation) < 0.5 and time.monotonic() < end:
+    while turned(gt0, gt()) < 0.5 and time.monotonic() < end:
         probe.cmd.publish(turn)
         probe.spin(0.1)
-    assert turned(gt0, probe.got[n.GROUND_TRUTH_POSE][-1].pose.orientation) >= 0.5
-    assert turned(odom0, probe.got[n.ODOM][-1].pose.pose.orientation) > 0.3      # odometry saw the turn
-    scan1 = np.array(probe.got[n.SCAN][-1].ranges)
+    assert turned(gt0, gt()) >= 0.5
+    assert turned(odom0, convert.odometry_of(probe.got[n.ODOM][-1])[0]) > 0.3      # odometry saw the turn
+    scan1 = convert.scan_of(probe.got[n.SCAN][-1]).ranges
     both = np.isfinite(scan0) & np.isfinite(scan1)
     assert np.abs(scan1[both] - scan0[both]).max() > 0.1
 
@@ -188,10 +189,9 @@ def test_map_reaches_a_late_subscriber(sim):
     sub = probe.node.create_subscription(OccupancyGrid, n.MAP, got.append, LATCHED_QOS)
     assert spin_until(probe.node, lambda: bool(got), 10)
     probe.node.destroy_subscription(sub)
-    grid = got[-1]
-    data = np.array(grid.data)
-    assert grid.header.frame_id == n.MAP_FRAME and data.size == grid.info.width * grid.info.height
-    assert set(np.unique(data)) == {-1, 0, 100}
+    grid = convert.grid_of(got[-1])
+    assert got[-1].header.frame_id == n.MAP_FRAME and grid.data.size == got[-1].info.width * got[-1].info.height
+    assert set(np.unique(grid.data)) == {-1, 0, 100}
 
 
 def test_ground_truth_query_answers(sim):
@@ -211,9 +211,7 @@ def test_client_helper(sim):
 
 def test_get_plan_stays_in_free_space(sim):
     _, probe = sim
-    grid_msg = probe.call(GetMap, n.GET_FREE_SPACE_SERVICE, GetMap.Request()).map
-    grid = Grid(np.array(grid_msg.data, np.int8).reshape(grid_msg.info.height, grid_msg.info.width),
-                (grid_msg.info.origin.position.x, grid_msg.info.origin.position.y), grid_msg.info.resolution)
+    grid = convert.grid_of(probe.call(GetMap, n.GET_FREE_SPACE_SERVICE, GetMap.Request()).map)
     free = np.argwhere(grid.data == FREE)
     start, goal = grid.center_of(*free[0]), grid.center_of(*free[-1])
     req = GetPlan.Request()
@@ -233,7 +231,7 @@ def test_appearance_change_alters_the_next_image(sim):
     def brightness() -> float:
         probe.got[n.COLOR_IMAGE].clear()
         spin_until(probe.node, lambda: len(probe.got[n.COLOR_IMAGE]) >= 2, 10)
-        return float(np.frombuffer(probe.got[n.COLOR_IMAGE][-1].data, np.uint8).mean())
+        return float(convert.image_array(probe.got[n.COLOR_IMAGE][-1]).mean())
 
     day = brightness()
     reply = probe.call(AddDiagnostics, n.APPEARANCE_SERVICE,
@@ -250,8 +248,8 @@ def test_appearance_change_alters_the_next_image(sim):
 def test_capture_service_publishes_now(sim):
     _, probe = sim
     reply = probe.call(Trigger, n.CAPTURE_SERVICE, Trigger.Request())
-    event = json.loads(reply.message)
-    assert reply.success and event["room"] and len(event["pose"]) == 3
+    event = CaptureEvent.from_json(reply.message)
+    assert reply.success and event.room and event.agent == n.DEFAULT_AGENT and len(event.pose) == 3
 
 
 def test_bad_velocities_are_refused_with_a_warning(sim):

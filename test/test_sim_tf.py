@@ -27,6 +27,7 @@ from tf2_msgs.msg import TFMessage  # noqa: E402
 
 from ravh_msgs_py import names as n  # noqa: E402
 from ravh_sim.nav.grid import FREE, OCCUPIED  # noqa: E402
+from ravh_sim.nodes import convert  # noqa: E402
 from ravh_sim.nodes.common import LATCHED_QOS, SENSOR_QOS, STATE_QOS  # noqa: E402
 
 CONFIG = """agents:
@@ -194,15 +195,13 @@ def test_map_is_an_obstacle_map_where_the_laser_ends(sim):
     sub = watcher.node.create_subscription(OccupancyGrid, n.MAP, grids.append, LATCHED_QOS)
     assert spin_until(watcher.node, lambda: bool(grids), 10)
     watcher.node.destroy_subscription(sub)
-    msg = grids[-1]
-    data = np.array(msg.data, np.int8).reshape(msg.info.height, msg.info.width)
-    origin, res = (msg.info.origin.position.x, msg.info.origin.position.y), msg.info.resolution
+    grid = convert.grid_of(grids[-1])
+    data, origin, res = grid.data, grid.origin, grid.resolution
     assert set(np.unique(data)) == {-1, 0, 100}
     near = cv2.dilate((data == OCCUPIED).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
     scan = watcher.sensors[n.SCAN][-1]
     pose = watcher.poses.get(stamp_ns(scan.header.stamp)) or max(watcher.poses.items())[1]
-    x, y = pose.pose.position.x, pose.pose.position.y
-    yaw = 2 * math.atan2(pose.pose.orientation.z, pose.pose.orientation.w)
+    x, y, yaw = convert.pose_of(pose.pose)
     hits = []
     for i, d in enumerate(scan.ranges):
         if math.isfinite(d):
@@ -234,4 +233,15 @@ def test_a_bad_map_tf_is_a_one_line_error():
     out = subprocess.run([sys.executable, "-m", "ravh_sim.cli", "sim", "--house", "20", "--ros-args", "-p",
                           "map_tf:=bogus"], capture_output=True, text=True, env=ros_env(), timeout=120)
     assert out.returncode == 2 and "map_tf must be one of auto, on, off, got 'bogus'" in out.stderr
+    assert "Traceback" not in out.stderr
+
+
+def test_a_negative_rate_is_a_one_line_error():
+    import subprocess
+    import sys
+
+    from rosgraph import ros_env
+    out = subprocess.run([sys.executable, "-m", "ravh_sim.cli", "sim", "--house", "20", "--scan-rate", "-5"],
+                         capture_output=True, text=True, env=ros_env(), timeout=120)
+    assert out.returncode == 2 and "scan_rate must be >= 0 Hz (0 = never), got -5.0" in out.stderr
     assert "Traceback" not in out.stderr

@@ -29,10 +29,8 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import yaml
 
-from ravh_msgs_py import names
 from ravh_sim.behaviours.grid import GridSweep
 from ravh_sim.behaviours.wanderer import Wanderer
 from ravh_sim.behaviours.waypoints import ORDERS, Layout, grid_nodes, light_waypoints
@@ -41,7 +39,7 @@ from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nav.follower import CONTROL_PERIOD, PathFollower
 from ravh_sim.poses import Pose2D
-from ravh_sim.runtime import Agent, Rates, SimRuntime
+from ravh_sim.runtime import Agent, SimRuntime
 
 SETTINGS_FILE = "raid_settings.yaml"
 MAX_SIM_S = 3600.0               # sim seconds after which a behaviour that never ends is stopped
@@ -100,7 +98,7 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
     with DatasetWriter(out) as writer:         # refuses a folder with a dataset before writing anything
         settings_path = out / SETTINGS_FILE
         settings_path.write_text(yaml.safe_dump(settings or {}, sort_keys=False))
-        runtime = SimRuntime(house, settings_path, seed, renderer=renderer, rates=Rates(0.0, 0.0, 0.0, 0.0))
+        runtime = SimRuntime(house, settings_path, seed, renderer=renderer)
         try:
             meta = {"house": runtime.house.number, "engine": "direct", "behaviour": _describe(spec),
                     "seed": runtime.world.state.seed, **(raid or {})}
@@ -128,12 +126,6 @@ def _describe(spec: BehaviourSpec) -> dict[str, Any]:
     if isinstance(spec, PosesSpec):
         return {"name": spec.name, "poses": len(spec.poses)}
     return {"name": spec.name, **asdict(spec)}
-
-
-def float32(value: float) -> float:
-    """``value`` as a float32 field of a ROS message carries it (LaserScan's angles and ranges),
-    so both engines store the same numbers."""
-    return float(np.float32(value))
 
 
 class _Session:
@@ -186,27 +178,16 @@ class _Session:
                         spec.seed)
 
     def capture(self) -> None:
-        """Render and write one capture (camera and laser at the same sim time, as the sim node's
-        capture service does)."""
-        rt, agent = self.runtime, self.agent
-        cap, scan = rt.capture(agent), rt.scan(agent)
-        x, y, yaw = agent.robot.pose
-        room = rt.room_of(agent)
-        info = cap.camera_info
-        camera = {"width": info.width, "height": info.height, "K": list(info.K), "D": list(info.D),
-                  "distortion_model": info.distortion_model,
-                  "frame_id": names.agent_name(info.frame_id, agent.name, agent.first)}
+        """Read every sensor at this sim time and write the sample (as the sim node's capture service
+        publishes it and the recorder stores it)."""
+        event, values = self.runtime.sample(self.agent)
         if len(self._writes) >= WRITES_IN_FLIGHT:
             self._writes.popleft().result()          # re-raises a failed write here
-        self._writes.append(self._worker.submit(
-            self.writer.write_capture, rt.time, agent.name, (x, y, yaw), agent.robot.odometry, room,
-            cap.rgb, cap.depth, cap.instance.astype(np.uint16), scan.ranges,
-            {"angle_min": float32(scan.angle_min), "angle_increment": float32(scan.angle_increment),
-             "range_min": float32(scan.range_min), "range_max": float32(scan.range_max)}, camera))
-        self.rows.append(room)
+        self._writes.append(self._worker.submit(self.writer.write_capture, event, values))
+        self.rows.append(event.room)
         if self.first_stamp is None:
-            self.first_stamp = rt.time
-        self.sim_span = rt.time - self.first_stamp
+            self.first_stamp = event.stamp
+        self.sim_span = event.stamp - self.first_stamp
         if self.progress:
             self.progress(len(self.rows))
 

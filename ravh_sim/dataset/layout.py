@@ -26,18 +26,13 @@ MAP_NAME = "map"
 BAG_DIR = "bag"                        # rosbag2, MCAP storage
 RAID_JSON = "raid.json"                # a raid's summary, written when it ends (``ravh raid``, the engines)
 
-#: Per-capture files: kind -> (folder, extension).
-CAPTURE_FILES: dict[str, tuple[str, str]] = {
-    "rgb": ("rgb", ".png"),            # 8-bit RGB
-    "depth": ("depth", ".png"),        # 16-bit millimetres, 0 = no depth
-    "mask": ("mask", ".png"),          # 16-bit instance ids, 0 = nothing
-    "scan": ("scan", ".npy"),          # float32 (N, 2): angle (rad), range (m; inf/nan as published)
-}
 
 
-def capture_files(index: int) -> dict[str, str]:
-    """Relative paths of capture ``index``'s files, by kind."""
-    return {kind: f"{folder}/{index:06d}{ext}" for kind, (folder, ext) in CAPTURE_FILES.items()}
+def capture_file(kind: str, ext: str, index: int) -> str:
+    """The relative path of capture ``index``'s file of ``kind``: one folder per kind. The kinds are
+    the sensor ports' (``SensorPort.files``): rgb (8-bit RGB PNG), depth (16-bit millimetres, 0 = no
+    depth), mask (16-bit instance ids, 0 = nothing), scan (float32 (N, 2) .npy: angle, range)."""
+    return f"{kind}/{index:06d}{ext}"
 
 
 def encode_png(image: np.ndarray) -> bytes:

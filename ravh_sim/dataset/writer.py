@@ -12,21 +12,18 @@ import json
 import os
 import shutil
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
+from ravh_msgs_py.capture import CaptureEvent
 from ravh_sim.dataset import layout
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.mapio import write_map
-from ravh_sim.sensors import imaging
+from ravh_sim.sensors.suite import SENSORS, capture_files
 from ravh_sim.world.footprint import dump_footprint
-
-Pose2D = Sequence[float]
 
 
 class DatasetWriter:
@@ -42,13 +39,13 @@ class DatasetWriter:
                 self._rows = open(self.dir / layout.CAPTURES_JSONL, "x", encoding="utf-8")
             except FileExistsError:
                 raise UserError(f"{self.dir} already holds {layout.CAPTURES_JSONL}; record into a new folder") from None
-            for folder, _ in layout.CAPTURE_FILES.values():
-                (self.dir / folder).mkdir(exist_ok=True)
+            for kind in capture_files(0):
+                (self.dir / kind).mkdir(exist_ok=True)
         except OSError as e:
             raise UserError(f"{e.filename or self.dir}: cannot write the dataset: {e.strerror}") from None
         self.count = 0
         self._room_types: dict[str, str] = {}
-        self._cameras: dict[str, dict[str, Any]] = {}
+        self._agent_facts: dict[str, dict[str, Any]] = {}    # side file (camera.json) -> agent -> entry
 
     # ------------------------------------------------------------------ once (or on change)
     def write_footprint(self, footprint: dict[str, Any]) -> None:
@@ -81,40 +78,33 @@ class DatasetWriter:
             shutil.rmtree(staging, ignore_errors=True)
 
     # ------------------------------------------------------------------ per capture
-    def write_capture(self, stamp: float, agent: str, pose: Pose2D, odom: Pose2D, room: str | None,
-                      rgb: np.ndarray, depth: np.ndarray, instance: np.ndarray, scan_ranges: np.ndarray,
-                      scan_meta: dict[str, float], camera: dict[str, Any] | None = None) -> int:
+    def write_capture(self, event: CaptureEvent, values: Mapping[str, Any]) -> int:
         """Store one capture and return its index.
 
-        rgb: (H, W, 3) uint8 RGB; depth: (H, W) float metres, NaN/inf = none; instance: (H, W)
-        instance ids; scan_meta: angle_min, angle_increment, range_min, range_max (LaserScan
-        fields); camera: the agent's intrinsics (width, height, K, D, ...), stored in camera.json.
+        ``values``: every sensor's dataset values by topic key (ravh_sim.sensors.suite), as
+        :meth:`SimRuntime.sample` reads them and the recorder decodes them from the topics; each
+        sensor port turns its own into files and fields.
         """
-        h, w = rgb.shape[:2]
-        if rgb.shape != (h, w, 3) or depth.shape != (h, w) or instance.shape != (h, w):
-            raise ValueError(f"image shapes differ: rgb {rgb.shape}, depth {depth.shape}, "
-                             f"instance {instance.shape}")
-        if instance.size and (instance.min() < 0 or instance.max() > np.iinfo(np.uint16).max):
-            raise ValueError("instance ids must fit in 16 bits")
         index = self.count
-        files = layout.capture_files(index)
-        payload = {
-            "rgb": layout.encode_png(np.ascontiguousarray(rgb, np.uint8)),
-            "depth": layout.encode_png(imaging.depth_to_png(depth)),
-            "mask": layout.encode_png(instance.astype(np.uint16)),
-            "scan": layout.encode_scan(scan_ranges, scan_meta["angle_min"], scan_meta["angle_increment"]),
-        }
-        for kind, data in payload.items():
-            layout.atomic_write(self.dir / files[kind], data)
-        if camera is not None and self._cameras.get(agent) != camera:
-            self._cameras[agent] = camera
-            layout.atomic_write(self.dir / layout.CAMERA_JSON,
-                                (json.dumps(self._cameras, indent=1) + "\n").encode())
-        row = {"index": index, "stamp": float(stamp), "agent": agent,
-               "pose": [float(v) for v in pose], "odom": [float(v) for v in odom],
-               "room": room, "room_type": self._room_types.get(room) if room else None,
-               "files": files, "scan": {k: float(scan_meta[k]) for k in
-                                        ("angle_min", "angle_increment", "range_min", "range_max")}}
+        files = capture_files(index)
+        room = event.room
+        row: dict[str, Any] = {"index": index, "stamp": float(event.stamp), "agent": event.agent,
+                               "pose": [float(v) for v in event.pose], "odom": [float(v) for v in event.odom],
+                               "room": room, "room_type": self._room_types.get(room) if room else None,
+                               "files": files}
+        stored = [port.store(values) for port in SENSORS]
+        contents = {kind: data for part in stored for kind, data in part.files.items()}
+        if contents.keys() != files.keys():
+            raise ValueError(f"the sensors stored files {sorted(contents)}, they declare {sorted(files)}")
+        for kind, path in files.items():
+            layout.atomic_write(self.dir / path, contents[kind])
+        for part in stored:
+            row.update(part.row)
+            for name, fact in part.agent_facts.items():
+                facts = self._agent_facts.setdefault(name, {})
+                if facts.get(event.agent) != fact:
+                    facts[event.agent] = fact
+                    layout.atomic_write(self.dir / name, (json.dumps(facts, indent=1) + "\n").encode())
         self._rows.write(json.dumps(row) + "\n")
         self._rows.flush()
         os.fsync(self._rows.fileno())

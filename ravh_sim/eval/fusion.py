@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
+from ravh_msgs_py.names import DEFAULT_PROFILE
 from ravh_sim.dataset.api import Dataset, Sample
 from ravh_sim.eval.semantic_map import LabelledBox, SemanticMap, box_of_points
 from ravh_sim.robot.profile import load_profile
@@ -64,7 +65,8 @@ class CameraModel:
     def __init__(self, dataset: Dataset) -> None:
         self.dataset = dataset
         profiles = {a.name: a.profile for a in dataset.settings.agents}
-        self._spec = {agent: load_profile(profiles.get(agent, "giraff")).camera for agent in dataset.meta["agents"]}
+        self._spec = {agent: load_profile(profiles.get(agent, DEFAULT_PROFILE)).camera
+                      for agent in dataset.meta["agents"]}
         self._K = {agent: np.array(cam["K"], float).reshape(3, 3) for agent, cam in dataset.camera.items()}
         self._D = {agent: np.array(cam.get("D") or [], float) for agent, cam in dataset.camera.items()}
         self._outside_floor_z = float(np.median([r.floor_z for r in dataset.house.rooms]))   # as World's

@@ -1,8 +1,10 @@
 """A behaviour (Wanderer, Grid) as a separate ROS process that only uses the sim node's interface.
 
-The node learns the house from the ground-truth service (rooms, floors, ceiling lights) and /map,
-follows the robot on ground_truth/pose, drives it with cmd_vel and asks for captures through the
-capture service. It runs on sim time, so it keeps pace with a sim that runs faster than real time.
+The node learns its agent from the footprint on /ravh/ground_truth (the first agent unless told; the
+first one drives the plain topics, whatever its name), the house from the ground-truth service
+(rooms, floors, ceiling lights) and /ravh/free_space, follows the robot on ground_truth/pose,
+drives it with cmd_vel and asks for captures through the capture service. It runs on sim time, so it
+keeps pace with a sim that runs faster than real time.
 Every capture it gets back is logged with its pose and room (and written to ``--log`` as JSON lines).
 
 With ``--wait-recorder`` (what ``ravh raid`` uses) a capture counts only once a recorder says it stored
@@ -22,10 +24,10 @@ import math
 import os
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import OccupancyGrid
 from rclpy.clock import Clock, ClockType
@@ -36,6 +38,7 @@ from std_msgs.msg import String
 from std_srvs.srv import Trigger
 
 from ravh_msgs_py import names as n
+from ravh_msgs_py.capture import CaptureEvent, CaptureFormatError, CaptureRecorded
 from ravh_msgs_py.client import RavhClient
 from ravh_sim.behaviours.waypoints import Layout
 from ravh_sim.errors import UserError
@@ -45,10 +48,9 @@ from ravh_sim.nav.planner import Path as PlannedPath
 from ravh_sim.nav.planner import plan_path
 from ravh_sim.nodes import convert
 from ravh_sim.nodes.common import COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, STATE_QOS, SimWatchdog, quiet_after_shutdown
-from ravh_sim.poses import Pose2D, yaw_from_quaternion
+from ravh_sim.poses import Pose2D
 from ravh_sim.robot.profile import load_profile
 
-FIRST_AGENT = "robot"            # the default settings' agent; other agents' topics are prefixed
 CONTROL_HZ = 20.0                # sim-time control rate (as nav2's controllers)
 STARTUP_TIMEOUT_S = 60.0
 RECORD_TIMEOUT_S = 60.0          # wall seconds a recorder may take to confirm a capture
@@ -73,8 +75,8 @@ class RosRobot:
 
     @property
     def pose(self) -> Pose2D:
-        p = self.pose_msg.pose
-        return (p.position.x, p.position.y, yaw_from_quaternion(p.orientation.z, p.orientation.w))
+        assert self.pose_msg is not None, "no pose yet"
+        return convert.pose_of(self.pose_msg.pose)
 
     def set_command(self, v: float, w: float) -> None:
         self.command = (float(v), float(w))
@@ -92,22 +94,46 @@ class RosNavigation:
         node.create_subscription(OccupancyGrid, n.FREE_SPACE_MAP, self._on_map, LATCHED_QOS)
 
     def _on_map(self, msg: OccupancyGrid) -> None:
-        data = np.array(msg.data, dtype=np.int8).reshape(msg.info.height, msg.info.width)
-        self.grid = Grid(data, (msg.info.origin.position.x, msg.info.origin.position.y), msg.info.resolution)
+        self.grid = convert.grid_of(msg)
 
     def map(self) -> Grid:
+        assert self.grid is not None, "no free-space map yet"
         return self.grid
 
     def plan(self, start: tuple[float, float], goal: tuple[float, float]) -> PlannedPath:
-        return plan_path(self.grid, start, goal)
+        return plan_path(self.map(), start, goal)
+
+
+def which_agent(node: Node, wanted: str | None) -> tuple[str, bool, str]:
+    """(name, first, profile) of the agent to drive: ``wanted`` or else the sim's first agent, as the
+    latched footprint lists them (the first uses the plain topic names, whatever it is called)."""
+    import rclpy
+    got: list[str] = []
+    sub = node.create_subscription(String, n.GROUND_TRUTH, lambda m: got.append(m.data), LATCHED_QOS)
+    end = time.monotonic() + STARTUP_TIMEOUT_S
+    while not got and time.monotonic() < end:
+        rclpy.spin_once(node, timeout_sec=0.1)
+    node.destroy_subscription(sub)
+    if not got:
+        raise UserError(f"no sim node published {n.GROUND_TRUTH} within {STARTUP_TIMEOUT_S:.0f} s "
+                        f"(is `ravh sim` running on ROS_DOMAIN_ID {os.environ.get('ROS_DOMAIN_ID', '0')}?)")
+    footprint = json.loads(got[0])
+    agents = n.footprint_agents(footprint)
+    if not agents:
+        raise UserError("the sim has no agents")
+    name = wanted or agents[0]
+    if name not in agents:
+        raise UserError(f"unknown agent {name!r}; the sim has {', '.join(agents)}")
+    spec = footprint["settings"]["agents"][agents.index(name)]
+    return name, name == agents[0], str(spec.get("profile", n.DEFAULT_PROFILE))
 
 
 def layout_from_ground_truth(client: RavhClient) -> Layout:
     """Room floors and ceiling lights from the sim's ground-truth queries."""
-    rooms = {}
+    rooms: dict[str, tuple[tuple[tuple[float, float], ...], ...]] = {}
     for summary in client.query("rooms"):
         room = client.query("room", id=summary["id"])
-        rooms[room["id"]] = (tuple(tuple(p) for p in room["floor"]),)
+        rooms[room["id"]] = (tuple((float(x), float(y)) for x, y in room["floor"]),)
     lights = tuple((o["room"], tuple(o["position"][:2])) for o in client.query("objects_with_tag", tag="Light"))
     return Layout(rooms, lights)
 
@@ -116,10 +142,11 @@ class BehaviourNode(Node):
     """Hosts one behaviour: ``make_behaviour(follower, layout, grid, start_xy)`` builds it once the sim is up."""
 
     def __init__(self, name: str, make_behaviour: Callable[[PathFollower, Layout, Grid, tuple], Any],
-                 agent: str = FIRST_AGENT, profile: str = "giraff", log_path: Path | None = None,
+                 agent: str | None = None, profile: str | None = None, log_path: Path | None = None,
                  wait_recorder: bool = False, lockstep: bool = False) -> None:
+        """``agent``: None drives the sim's first agent; ``profile``: None takes the agent's from the sim."""
         super().__init__(name, parameter_overrides=[Parameter("use_sim_time", value=True)])
-        first = agent == FIRST_AGENT
+        agent, first, agent_profile = which_agent(self, agent)
         self.robot = RosRobot(self, agent, first, lockstep)
         self.navigation = RosNavigation(self)
         self.client = RavhClient(self)
@@ -128,7 +155,7 @@ class BehaviourNode(Node):
         self.finished = Future()                 # done when the behaviour ends (run_node returns then)
         self._pending: set[Future] = set()
         self.wait_recorder, self.lockstep = wait_recorder, lockstep
-        self._unrecorded: dict[float, tuple[dict[str, Any], float]] = {}   # stamp -> (event, wall deadline)
+        self._unrecorded: dict[float, tuple[CaptureEvent, float]] = {}   # stamp -> (event, wall deadline)
         if wait_recorder:
             self.create_subscription(String, n.agent_name(n.CAPTURE_RECORDED, agent, first), self._on_recorded,
                                      HANDOVER_QOS)
@@ -137,8 +164,8 @@ class BehaviourNode(Node):
         self.create_timer(1.0, self._check_recorder, clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._wait_for_sim()
         layout = layout_from_ground_truth(self.client)
-        follower = PathFollower(self.robot, self.navigation, load_profile(profile))
-        self.behaviour = make_behaviour(follower, layout, self.navigation.grid, self.robot.pose[:2])
+        follower = PathFollower(self.robot, self.navigation, load_profile(profile or agent_profile))
+        self.behaviour = make_behaviour(follower, layout, self.navigation.map(), self.robot.pose[:2])
         self._last_t: float | None = None
         self._rooms_seen: set[str] = set()
         self._granted: float | None = 0.0            # lockstep: sim time granted and not reached yet
@@ -174,7 +201,7 @@ class BehaviourNode(Node):
 
     def _on_pose_lockstep(self, msg: PoseStamped) -> None:
         """Lockstep: the sim reached the granted time; act on its state there, then grant the next step."""
-        t = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        t = convert.seconds(msg.header.stamp)
         if self._granted is None or t + 1e-6 < self._granted:
             return
         self._granted, self._reached = None, t
@@ -234,31 +261,34 @@ class BehaviourNode(Node):
                 raise UserError(problem)
             self.get_logger().warning(problem)
         else:
-            event = json.loads(result.message)
-            event["reason"] = reason
+            event = replace(CaptureEvent.from_json(result.message), reason=reason)
             if self.wait_recorder:
-                self._unrecorded[event["stamp"]] = (event, time.monotonic() + RECORD_TIMEOUT_S)
+                self._unrecorded[event.stamp] = (event, time.monotonic() + RECORD_TIMEOUT_S)
             else:
                 self._record(event)
         self._finish_when_answered()
         self._grant_when_ready()
 
     def _on_recorded(self, msg: String) -> None:
-        stamp = json.loads(msg.data)["stamp"]
+        try:
+            stamp = CaptureRecorded.from_json(msg.data).stamp
+        except CaptureFormatError as e:
+            self.get_logger().error(f"ignored a capture confirmation: {e}")
+            return
         if stamp in self._unrecorded:
             self._record(self._unrecorded.pop(stamp)[0])
             self._finish_when_answered()
             self._grant_when_ready()
 
-    def _record(self, event: dict[str, Any]) -> None:
+    def _record(self, event: CaptureEvent) -> None:
         self.capture_count += 1
-        if event.get("room"):
-            self._rooms_seen.add(event["room"])
-        x, y, yaw = event["pose"]
-        self.get_logger().info(f"capture {self.capture_count} t={event['stamp']:.2f} pose=({x:.2f}, {y:.2f}, "
-                               f"{math.degrees(yaw):.0f} deg) room={event['room']} [{event['reason']}]")
+        if event.room:
+            self._rooms_seen.add(event.room)
+        x, y, yaw = event.pose
+        self.get_logger().info(f"capture {self.capture_count} t={event.stamp:.2f} pose=({x:.2f}, {y:.2f}, "
+                               f"{math.degrees(yaw):.0f} deg) room={event.room} [{event.reason}]")
         if self._log_file:
-            self._log_file.write(json.dumps(event) + "\n")
+            self._log_file.write(event.to_json() + "\n")
             self._log_file.flush()
 
     def close(self) -> None:
@@ -270,9 +300,9 @@ class BehaviourNode(Node):
 
 def common_args(prog: str, description: str) -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog=prog, description=description)
-    p.add_argument("--agent", default=FIRST_AGENT,
-                   help=f"agent to drive (default {FIRST_AGENT}, whose topics have no prefix)")
-    p.add_argument("--profile", default="giraff", help="robot profile of that agent")
+    p.add_argument("--agent", default=None,
+                   help="agent to drive (default: the sim's first, whose topics have no prefix)")
+    p.add_argument("--profile", default=None, help="robot profile of that agent (default: its profile in the sim)")
     p.add_argument("--log", type=Path, help="append every capture (pose, room) to this JSON-lines file")
     p.add_argument("--wait-recorder", action="store_true",
                    help="count a capture only once a recorder stored it; hold still until then")

@@ -1,6 +1,9 @@
-"""Core values to ROS messages: the only place that knows both numpy arrays and message fields.
+"""Core values <-> ROS messages, both ways: the only place that knows both numpy arrays and message fields.
 
-Kept free of node state so each conversion is a small pure function, unit-tested without a ROS graph.
+Every node and test converts here: the sim node builds messages from the runtime's values, the
+recorder and the behaviours turn messages back into arrays, grids and poses. Sensor topics are
+converted by message kind (:data:`KINDS`, named by each port's topics in ravh_sim.sensors). Kept
+free of node state so each conversion is a small pure function, unit-tested without a ROS graph.
 Large arrays are copied with ``array.array.frombytes`` (0.1 ms for an rgb8 frame vs ~1 ms through a
 Python list, measured here).
 """
@@ -8,7 +11,9 @@ from __future__ import annotations
 
 import array
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from builtin_interfaces.msg import Time
@@ -19,7 +24,8 @@ from sensor_msgs.msg import CameraInfo, CompressedImage, Image, LaserScan
 from std_msgs.msg import Header
 
 from ravh_sim.nav.grid import Grid
-from ravh_sim.poses import Pose2D, quaternion_from_yaw
+from ravh_sim.poses import Pose2D, quaternion_from_yaw, yaw_from_quaternion
+from ravh_sim.sensors import readings
 
 
 def stamp(seconds: float) -> Time:
@@ -57,25 +63,20 @@ def compressed(jpeg: bytes, hdr: Header) -> CompressedImage:
     return msg
 
 
-def camera_info(k: np.ndarray, width: int, height: int, hdr: Header,
-                d: Sequence[float] = (0.0, 0.0, 0.0, 0.0, 0.0)) -> CameraInfo:
-    """CameraInfo for a pinhole camera (plumb_bob distortion ``d``; P = [K | 0] for a mono camera)."""
-    k = np.asarray(k, dtype=float)
-    p = np.zeros((3, 4))
-    p[:, :3] = k
-    return CameraInfo(header=hdr, width=width, height=height, distortion_model="plumb_bob",
-                      d=[float(x) for x in d], k=k.reshape(-1).tolist(),
-                      r=np.eye(3).reshape(-1).tolist(), p=p.reshape(-1).tolist())
+def camera_info(info: readings.CameraInfo, hdr: Header) -> CameraInfo:
+    """CameraInfo of a pinhole camera (frame from ``hdr``: the one the images are stamped in)."""
+    return CameraInfo(header=hdr, width=info.width, height=info.height, distortion_model=info.distortion_model,
+                      d=[float(x) for x in info.D], k=[float(x) for x in info.K],
+                      r=[float(x) for x in info.R], p=[float(x) for x in info.P])
 
 
-def laser_scan(ranges: np.ndarray, angle_min: float, angle_increment: float, range_min: float,
-               range_max: float, scan_time: float, hdr: Header) -> LaserScan:
-    n = len(ranges)
-    msg = LaserScan(header=hdr, angle_min=float(angle_min),
-                    angle_max=float(angle_min + (n - 1) * angle_increment),
-                    angle_increment=float(angle_increment), time_increment=0.0,
-                    scan_time=float(scan_time), range_min=float(range_min), range_max=float(range_max))
-    msg.ranges = array.array("f", np.asarray(ranges, dtype=np.float32).tobytes())
+def laser_scan(scan: readings.Scan, hdr: Header) -> LaserScan:
+    """The rays are cast at one instant: time_increment 0."""
+    msg = LaserScan(header=hdr, angle_min=float(scan.angle_min), angle_max=float(scan.angle_max),
+                    angle_increment=float(scan.angle_increment), time_increment=0.0,
+                    scan_time=float(scan.scan_time), range_min=float(scan.range_min),
+                    range_max=float(scan.range_max))
+    msg.ranges = array.array("f", np.asarray(scan.ranges, dtype=np.float32).tobytes())
     return msg
 
 
@@ -131,3 +132,74 @@ def odometry(p: Pose2D, v: float, w: float, hdr: Header, child: str,
     msg.twist.twist.linear.x = float(v)
     msg.twist.twist.angular.z = float(w)
     return msg
+
+
+# ---------------------------------------------------------------------------- messages -> values
+
+def seconds(t: Time) -> float:
+    return t.sec + t.nanosec * 1e-9
+
+
+def image_array(msg: Image) -> np.ndarray:
+    """The pixels of an rgb8, 32FC1 or 16UC1 Image (row padding removed)."""
+    dtype, channels = {"rgb8": (np.uint8, 3), "32FC1": (np.float32, 1), "16UC1": (np.uint16, 1)}[msg.encoding]
+    row_bytes = msg.width * channels * np.dtype(dtype).itemsize
+    rows = np.frombuffer(msg.data, np.uint8).reshape(msg.height, msg.step)[:, :row_bytes]
+    a = np.ascontiguousarray(rows).view(dtype).reshape(msg.height, msg.width, channels)
+    return a[:, :, 0] if channels == 1 else a
+
+
+def jpeg_bytes(msg: CompressedImage) -> bytes:
+    return bytes(msg.data)
+
+
+def camera_info_of(msg: CameraInfo) -> readings.CameraInfo:
+    return readings.CameraInfo(msg.header.frame_id, msg.width, msg.height, msg.distortion_model,
+                               tuple(float(v) for v in msg.d), tuple(float(v) for v in msg.k),
+                               tuple(float(v) for v in msg.r), tuple(float(v) for v in msg.p))
+
+
+def scan_of(msg: LaserScan) -> readings.Scan:
+    return readings.Scan(msg.header.frame_id, msg.angle_min, msg.angle_max, msg.angle_increment, msg.time_increment,
+                         msg.scan_time, msg.range_min, msg.range_max, np.asarray(msg.ranges, np.float32))
+
+
+def grid_of(msg: OccupancyGrid) -> Grid:
+    data = np.array(msg.data, np.int8).reshape(msg.info.height, msg.info.width)
+    return Grid(data, (msg.info.origin.position.x, msg.info.origin.position.y), msg.info.resolution)
+
+
+def pose_of(pose: Pose) -> Pose2D:
+    """(x, y, yaw) of a Pose on the floor (the yaw of its quaternion)."""
+    return (pose.position.x, pose.position.y, yaw_from_quaternion(pose.orientation.z, pose.orientation.w))
+
+
+def odometry_of(msg: Odometry) -> tuple[Pose2D, float, float]:
+    """(pose in odom, v, w) of an Odometry."""
+    return pose_of(msg.pose.pose), msg.twist.twist.linear.x, msg.twist.twist.angular.z
+
+
+def transform_of(msg: TransformStamped) -> tuple[str, str, tuple[float, ...], tuple[float, ...]]:
+    """(parent, child, xyz, quaternion xyzw) of a transform."""
+    t, q = msg.transform.translation, msg.transform.rotation
+    return msg.header.frame_id, msg.child_frame_id, (t.x, t.y, t.z), (q.x, q.y, q.z, q.w)
+
+
+# ---------------------------------------------------------------------------- sensor message kinds
+
+@dataclass(frozen=True)
+class Kind:
+    """A sensor topic's message type and its conversions (``Topic.kind`` in ravh_sim.sensors.ports)."""
+    msg_type: type
+    to_message: Callable[[Any, Header], Any]
+    from_message: Callable[[Any], Any]
+
+
+KINDS: dict[str, Kind] = {
+    "rgb8": Kind(Image, lambda a, hdr: image(a, "rgb8", hdr), image_array),
+    "32FC1": Kind(Image, lambda a, hdr: image(a, "32FC1", hdr), image_array),
+    "16UC1": Kind(Image, lambda a, hdr: image(a, "16UC1", hdr), image_array),
+    "jpeg": Kind(CompressedImage, compressed, jpeg_bytes),
+    "camera_info": Kind(CameraInfo, camera_info, camera_info_of),
+    "laser_scan": Kind(LaserScan, laser_scan, scan_of),
+}

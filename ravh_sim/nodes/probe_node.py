@@ -21,6 +21,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Image, LaserScan
 
 from ravh_msgs_py import names as n
+from ravh_sim.nodes import convert
 from ravh_sim.nodes.common import SENSOR_QOS, STATE_QOS, run_node
 
 OFFSET_WINDOW_S = 1.0
@@ -48,7 +49,7 @@ class Probe(Node):
         return time.monotonic() - self.start >= self.warmup
 
     def _on_clock(self, msg: Clock) -> None:
-        wall, sim = time.time(), msg.clock.sec + msg.clock.nanosec * 1e-9
+        wall, sim = time.time(), convert.seconds(msg.clock)
         self.clock_window.append((wall, wall - sim))
         while self.clock_window[0][0] < wall - OFFSET_WINDOW_S:
             self.clock_window.popleft()
@@ -60,7 +61,7 @@ class Probe(Node):
         if self._measuring() and self.clock_window:
             stamp = msg.header.stamp
             offset = min(o for _, o in self.clock_window)
-            self.samples[topic].append((time.time(), stamp.sec + stamp.nanosec * 1e-9 + offset))
+            self.samples[topic].append((time.time(), convert.seconds(stamp) + offset))
 
     def _check(self) -> None:
         if time.monotonic() - self.start >= self.warmup + self.seconds and not self.finished.done():

@@ -5,17 +5,18 @@
 and only the messages that end up in the dataset are deserialized, in a worker thread that encodes
 and writes the files while the executor keeps receiving.
 
-A capture is the set of messages that share the stamp of a ``ravh/capture`` event: RGB, depth,
-instances, camera_infos and the scan. Events and images arrive on different topics in any order, so
-parts wait by stamp in :class:`StampMatcher` until the set is complete; periodic camera frames never
-get an event and are dropped unrecorded. The bag keeps the continuous streams (scan, odom,
-ground-truth pose, capture events, /tf) whole, the latched ones (/map, /tf_static, /ravh/ground_truth,
-instance labels) with transient-local QoS so ``ros2 bag play`` re-latches them, and of the camera only the
-captures (JPEG colour, depth, instances, camera_infos), so bag and dataset describe the same frames.
-Bag times are sim receive times (``use_sim_time``); messages that arrive before the first /clock are
-written at the first clock time. SIGINT closes the bag (metadata.yaml written); a SIGKILLed recorder
-leaves a dataset that reads back complete up to its last capture, and an MCAP without its summary
-(``mcap recover`` rebuilds it).
+A capture is the set of messages that share the stamp of a ``ravh/capture`` event: every sensor port's
+topics (ravh_sim.sensors.suite: RGB, depth, instances, camera_infos, the scan), decoded with
+ravh_sim.nodes.convert and stored by the ports through the DatasetWriter. Events and images arrive on
+different topics in any order, so parts wait by stamp in :class:`StampMatcher` until the set is
+complete; periodic camera frames never get an event and are dropped unrecorded. The bag keeps the
+continuous streams (scan, odom, ground-truth pose, capture events, /tf) whole, the latched ones (/map,
+/tf_static, /ravh/ground_truth, instance labels) with transient-local QoS so ``ros2 bag play``
+re-latches them, and of the camera only the captures (JPEG colour, depth, instances, camera_infos), so
+bag and dataset describe the same frames. Bag times are sim receive times (``use_sim_time``); messages
+that arrive before the first /clock are written at the first clock time. SIGINT closes the bag
+(metadata.yaml written); a SIGKILLed recorder leaves a dataset that reads back complete up to its last
+capture, and an MCAP without its summary (``mcap recover`` rebuilds it).
 
 Nothing is lost silently: each stored capture is confirmed on ``ravh/capture_recorded`` (reliable,
 keep-all), which a behaviour run with ``--wait-recorder`` waits for before it moves on; a capture that
@@ -34,29 +35,29 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, NamedTuple
 
-import numpy as np
 import rclpy.clock
 import rclpy.logging
 from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import OccupancyGrid, Odometry
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.publisher import Publisher
 from rclpy.qos import QoSProfile
 from rclpy.serialization import deserialize_message
 from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
-from sensor_msgs.msg import CameraInfo, CompressedImage, Image, LaserScan
 from std_msgs.msg import String
 from tf2_msgs.msg import TFMessage
 
 from ravh_msgs_py import names as n
+from ravh_msgs_py.capture import CaptureEvent, CaptureFormatError, CaptureRecorded
 from ravh_sim.dataset import layout
 from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
-from ravh_sim.nav.grid import Grid
 from ravh_sim.nodes import convert
 from ravh_sim.nodes.common import HANDOVER_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, SimWatchdog, run_node
+from ravh_sim.sensors.suite import SENSORS
 
 NS = 1_000_000_000
 PENDING_TIMEOUT_S = 30.0      # wall seconds a stamp's parts wait for the rest of their capture
@@ -70,16 +71,13 @@ class Part(NamedTuple):
     dataset: bool             # needed for the dataset (part of a capture's set)
     bag: bool                 # recorded in the bag
     per_capture: bool         # camera: waits by stamp, bagged only for captures (else streamed)
+    kind: str | None = None   # a sensor topic's message kind (convert.KINDS), to decode it for the dataset
 
 
+# Every sensor port's topics (ravh_sim.sensors.suite), then the agent's state and its capture events.
 PARTS: dict[str, Part] = {
-    "rgb": Part(n.COLOR_IMAGE, Image, SENSOR_QOS, True, False, True),
-    "jpeg": Part(n.COLOR_COMPRESSED, CompressedImage, SENSOR_QOS, False, True, True),
-    "depth": Part(n.DEPTH_IMAGE, Image, SENSOR_QOS, True, True, True),
-    "instance": Part(n.INSTANCE_IMAGE, Image, SENSOR_QOS, True, True, True),
-    "rgb_info": Part(n.COLOR_INFO, CameraInfo, SENSOR_QOS, True, True, True),
-    "depth_info": Part(n.DEPTH_INFO, CameraInfo, SENSOR_QOS, False, True, True),
-    "scan": Part(n.SCAN, LaserScan, SENSOR_QOS, True, True, False),
+    **{topic.key: Part(topic.base, convert.KINDS[topic.kind].msg_type, SENSOR_QOS, topic.dataset, topic.bag,
+                       port.captured, topic.kind) for port in SENSORS for topic in port.topics},
     "odom": Part(n.ODOM, Odometry, STATE_QOS, False, True, False),
     "gt_pose": Part(n.GROUND_TRUTH_POSE, PoseStamped, STATE_QOS, False, True, False),
     "event": Part(n.CAPTURE_EVENT, String, STATE_QOS, True, True, False),
@@ -194,28 +192,6 @@ class BagWriter:
         self._early.clear()
 
 
-# ---------------------------------------------------------------------------- decoding
-
-def image_array(msg: Image) -> np.ndarray:
-    """The pixels of an rgb8, 32FC1 or 16UC1 Image (row padding removed)."""
-    dtype, channels = {"rgb8": (np.uint8, 3), "32FC1": (np.float32, 1), "16UC1": (np.uint16, 1)}[msg.encoding]
-    row_bytes = msg.width * channels * np.dtype(dtype).itemsize
-    rows = np.frombuffer(msg.data, np.uint8).reshape(msg.height, msg.step)[:, :row_bytes]
-    a = np.ascontiguousarray(rows).view(dtype).reshape(msg.height, msg.width, channels)
-    return a[:, :, 0] if channels == 1 else a
-
-
-def camera_dict(info: CameraInfo) -> dict[str, Any]:
-    return {"width": info.width, "height": info.height, "K": [float(v) for v in info.k],
-            "D": [float(v) for v in info.d], "distortion_model": info.distortion_model,
-            "frame_id": info.header.frame_id}
-
-
-def grid_of(msg: OccupancyGrid) -> Grid:
-    data = np.array(msg.data, np.int8).reshape(msg.info.height, msg.info.width)
-    return Grid(data, (msg.info.origin.position.x, msg.info.origin.position.y), msg.info.resolution)
-
-
 # ---------------------------------------------------------------------------- the node
 
 class RecorderNode(Node):
@@ -234,7 +210,7 @@ class RecorderNode(Node):
         self.lost = 0                                 # captures announced but never stored
         self.failure: str | None = None               # the first write error (the worker thread's)
         self.exit_code = 0
-        self.recorded_pub = None
+        self.recorded_pub: Publisher | None = None        # made once the agent is known
         self.log = self.get_logger()
         self.topics: dict[str, str] = {}              # part -> resolved topic name
         for topic, (msg_type, in_dataset) in LATCHED.items():
@@ -244,11 +220,12 @@ class RecorderNode(Node):
                 if self.bag:
                     self.bag.add_topic(sub.topic_name, msg_type, latched=True)
                 self.topics[topic] = sub.topic_name
-        for topic, msg_type in STREAMS.items() if self.bag else ():
-            sub = self.create_subscription(msg_type, topic, lambda d, t=topic: self._on_stream(t, d), STATE_QOS,
-                                           raw=True)
-            self.bag.add_topic(sub.topic_name, msg_type, latched=False)
-            self.topics[topic] = sub.topic_name
+        if self.bag is not None:
+            for topic, msg_type in STREAMS.items():
+                sub = self.create_subscription(msg_type, topic, lambda d, t=topic: self._on_stream(t, d), STATE_QOS,
+                                               raw=True)
+                self.bag.add_topic(sub.topic_name, msg_type, latched=False)
+                self.topics[topic] = sub.topic_name
         SimWatchdog(self)
         self.create_timer(0.5, self._check_writes,
                           clock=rclpy.clock.Clock(clock_type=rclpy.clock.ClockType.STEADY_TIME))
@@ -256,7 +233,7 @@ class RecorderNode(Node):
 
     # ------------------------------------------------------------------ set-up once the world is known
     def _start(self, footprint: dict[str, Any]) -> None:
-        agents = [a["name"] for a in footprint["settings"].get("agents", [])]
+        agents = n.footprint_agents(footprint)
         if not agents:
             raise UserError("the footprint names no agents; nothing to record")
         agent = self.wanted_agent or agents[0]
@@ -289,20 +266,26 @@ class RecorderNode(Node):
             if self.agent is None:
                 self._start(footprint)
         elif topic == n.MAP:
-            self._submit(self.writer.write_map, grid_of(deserialize_message(data, OccupancyGrid)))
+            self._submit(self.writer.write_map, convert.grid_of(deserialize_message(data, OccupancyGrid)))
 
     def _on_stream(self, topic: str, data: bytes) -> None:
+        assert self.bag is not None, "streams are subscribed for the bag only"
         self.bag.write(self.topics[topic], self._now_ns(), data)
 
     def _on_part(self, key: str, data: bytes) -> None:
         now_ns, part = self._now_ns(), self.parts[key]
+        value: CaptureEvent | tuple[int, bytes]
         if self.bag and part.bag and not part.per_capture:
             self.bag.write(self.topics[key], now_ns, data)
         if key == "event":
-            event = json.loads(deserialize_message(data, String).data)
-            if event.get("agent") != self.agent:
+            try:
+                event = CaptureEvent.from_json(deserialize_message(data, String).data)
+            except CaptureFormatError as e:
+                self.log.error(f"ignored a message on {self.topics[key]}: {e}")
                 return
-            stamp, value = event_stamp_ns(float(event["stamp"])), event
+            if event.agent != self.agent:
+                return
+            stamp, value = event_stamp_ns(event.stamp), event
         elif key in self.matcher.required:
             stamp, value = header_stamp_ns(data), (now_ns, data)
         else:
@@ -322,25 +305,20 @@ class RecorderNode(Node):
         self._submit(self._write_capture, parts)
 
     def _write_capture(self, parts: dict[str, Any]) -> None:
-        """Worker thread: deserialize what the dataset keeps and write it."""
-        msgs = {k: deserialize_message(parts[k][1], self.parts[k].msg_type) for k in
-                ("rgb", "depth", "instance", "rgb_info", "scan")}
-        event, scan = parts["event"], msgs["scan"]
-        index = self.writer.write_capture(
-            event["stamp"], event["agent"], event["pose"], event["odom"], event["room"],
-            image_array(msgs["rgb"]), image_array(msgs["depth"]), image_array(msgs["instance"]),
-            np.asarray(scan.ranges, np.float32),
-            {"angle_min": scan.angle_min, "angle_increment": scan.angle_increment,
-             "range_min": scan.range_min, "range_max": scan.range_max},
-            camera_dict(msgs["rgb_info"]))
+        """Worker thread: decode what the dataset keeps (every sensor's dataset topics) and write it."""
+        values = {key: convert.KINDS[part.kind].from_message(deserialize_message(parts[key][1], part.msg_type))
+                  for key, part in self.parts.items() if part.dataset and part.kind is not None}
+        event: CaptureEvent = parts["event"]
+        index = self.writer.write_capture(event, values)
         self.captures = index + 1
-        self._confirm(event["stamp"], index)
-        self.log.info(f"capture {index} at t={event['stamp']:.2f} s in {event['room']}")
+        self._confirm(event.stamp, index)
+        self.log.info(f"capture {index} at t={event.stamp:.2f} s in {event.room}")
 
     def _confirm(self, stamp: float, index: int) -> None:
         """Tell the behaviour its capture is stored (not possible any more once SIGINT shut ROS down)."""
+        assert self.recorded_pub is not None, "captures are matched only once the agent is known"
         try:
-            self.recorded_pub.publish(String(data=json.dumps({"stamp": stamp, "index": index})))
+            self.recorded_pub.publish(String(data=CaptureRecorded(stamp, index).to_json()))
         except Exception:
             if self.context.ok():
                 raise

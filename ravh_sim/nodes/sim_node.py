@@ -10,8 +10,10 @@ All names come from ``ravh_msgs_py.names``. Parameters are read-only (they shape
 publishes that edge. The ground truth stays on ``map_to_odom`` and ``ground_truth/pose`` either way.
 With ``--lockstep`` it advances only as far as a behaviour grants on ``ravh/step`` (which carries the
 command for that step), so a run depends on sim time alone and repeats exactly with the same seed.
-Requests never take it down: bad commands are refused with a throttled warning, bad service
-requests get an error reply.
+Sensor topics come from the sensor suite (ravh_sim.sensors.suite): each port's topics, published at
+its rate (the robot profile's; ``camera_rate``, ``scan_rate``, ``odom_rate`` override them for every
+agent when >= 0). Requests never take it down: bad commands are refused with a throttled warning,
+bad service requests get an error reply.
 """
 from __future__ import annotations
 
@@ -32,12 +34,12 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import CameraInfo, CompressedImage, Image, LaserScan
 from std_msgs.msg import String
 from std_srvs.srv import Trigger
 from tf2_msgs.msg import TFMessage
 
 from ravh_msgs_py import names as n
+from ravh_msgs_py.capture import CaptureEvent
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nodes import convert
@@ -51,8 +53,9 @@ from ravh_sim.nodes.common import (
     run_node,
 )
 from ravh_sim.render.backend import BACKENDS
-from ravh_sim.runtime import Agent, Rates, SimRuntime
-from ravh_sim.sensors.imaging import encode_jpeg
+from ravh_sim.runtime import ODOM, Agent, SimRuntime
+from ravh_sim.sensors.ports import SensorPort
+from ravh_sim.sensors.suite import SENSORS
 
 TICK_S = 0.005                          # wall period of the stepping timer
 MAX_STEP_S = 0.1                        # sim time advanced per tick at most (keeps services responsive)
@@ -63,9 +66,12 @@ MAP_TF_RESUME_S = 2.0                   # wall s without another map -> odom pub
 # Listening for other map -> odom publishers: best effort matches reliable and best-effort publishers.
 TF_LISTEN_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT)
 
+FROM_PROFILE = -1.0                     # a rate parameter's default: each agent's robot profile says
+# parameter -> rate key: camera_rate, scan_rate (one per sensor port) and odom_rate
+RATE_PARAMETERS = {f"{key}_rate": key for key in (*(port.name for port in SENSORS), ODOM)}
 PARAMETERS: dict[str, Any] = {
     "house": 15, "seed": -1, "config": "", "footprint": "", "renderer": "auto", "real_time_factor": 1.0,
-    "camera_rate": 10.0, "scan_rate": 10.0, "odom_rate": 50.0, "clock_rate": 100.0,
+    **dict.fromkeys(RATE_PARAMETERS, FROM_PROFILE), "clock_rate": 100.0,
     "cmd_vel_stamped": False, "map_tf": "auto", "lockstep": False,
 }
 HEARTBEAT_S = 0.5                       # lockstep: wall period of /clock and pose while waiting
@@ -83,10 +89,13 @@ class SimNode(Node):
         self.map_tf = str(p["map_tf"])
         if self.map_tf not in MAP_TF_MODES:
             raise UserError(f"map_tf must be one of {', '.join(MAP_TF_MODES)}, got {self.map_tf!r}")
+        rates = {key: float(p[param]) for param, key in RATE_PARAMETERS.items() if p[param] != FROM_PROFILE}
+        for param, key in RATE_PARAMETERS.items():
+            if key in rates and not (math.isfinite(rates[key]) and rates[key] >= 0):
+                raise UserError(f"{param} must be >= 0 Hz (0 = never), got {rates[key]}")
+        self.clock_period = 1.0 / max(float(p["clock_rate"]), 1e-3)
         self.runtime = SimRuntime(int(p["house"]), p["config"] or None, None if p["seed"] == -1 else p["seed"],
-                                  renderer=p["renderer"],
-                                  rates=Rates(p["camera_rate"], p["scan_rate"], p["odom_rate"], p["clock_rate"]),
-                                  footprint=p["footprint"] or None)
+                                  renderer=p["renderer"], rates=rates, footprint=p["footprint"] or None)
         rt = self.runtime
         self.get_logger().info(
             f"house {rt.house.number}: {len(rt.house.rooms)} rooms, {len(rt.house.objects)} objects, "
@@ -125,13 +134,8 @@ class SimNode(Node):
             def name(base: str, a: Agent = agent) -> str:
                 return n.agent_name(base, a.name, a.first)
             self.agent_pubs[agent.name] = {
-                "scan": pub(LaserScan, name(n.SCAN), SENSOR_QOS),
-                "rgb": pub(Image, name(n.COLOR_IMAGE), SENSOR_QOS),
-                "rgb_info": pub(CameraInfo, name(n.COLOR_INFO), SENSOR_QOS),
-                "jpeg": pub(CompressedImage, name(n.COLOR_COMPRESSED), SENSOR_QOS),
-                "depth": pub(Image, name(n.DEPTH_IMAGE), SENSOR_QOS),
-                "depth_info": pub(CameraInfo, name(n.DEPTH_INFO), SENSOR_QOS),
-                "instance": pub(Image, name(n.INSTANCE_IMAGE), SENSOR_QOS),
+                **{topic.key: pub(convert.KINDS[topic.kind].msg_type, name(topic.base), SENSOR_QOS)
+                   for port in SENSORS for topic in port.topics},
                 "odom": pub(Odometry, name(n.ODOM), STATE_QOS),
                 "gt_pose": pub(PoseStamped, name(n.GROUND_TRUTH_POSE), STATE_QOS),
                 "odom_tf": pub(TransformStamped, name(n.ODOM_TRANSFORM), STATE_QOS),
@@ -139,7 +143,7 @@ class SimNode(Node):
                 "room": pub(String, name(n.ROOM), LATCHED_QOS),
                 "capture": pub(String, name(n.CAPTURE_EVENT), STATE_QOS),
                 "static": {child: pub(TransformStamped, name(n.TF_STATIC_TOPIC.format(child=child)), LATCHED_QOS)
-                           for child in (n.LASER_FRAME, n.CAMERA_FRAME, n.CAMERA_OPTICAL_FRAME)},
+                           for _, child, _, _ in self.runtime.static_transforms(agent)},
                 "last_room": None,
             }
 
@@ -192,7 +196,7 @@ class SimNode(Node):
     def _on_step(self, agent: Agent, msg: TwistStamped) -> None:
         """Lockstep: the behaviour's command for the next step and the sim time it may run to."""
         self._on_cmd(agent, msg.twist)
-        self._allowed = max(self._allowed, msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9)
+        self._allowed = max(self._allowed, convert.seconds(msg.header.stamp))
         self._heartbeat = 0.0
 
     def _arrived(self) -> None:
@@ -215,16 +219,15 @@ class SimNode(Node):
         rt = self.runtime
         if rt.time + 1e-9 >= self._next_clock:
             self._now()
-            self._next_clock += 1.0 / max(rt.rates.clock, 1e-3)
+            self._next_clock += self.clock_period
         if rt.map_version != self._published_map:
             self._publish_map()
         for agent in rt.agents:
-            if rt.due(agent, "odom"):
+            if rt.due(agent, ODOM):
                 self._publish_state(agent)
-            if rt.due(agent, "scan"):
-                self._publish_scan(agent)
-            if rt.due(agent, "camera"):
-                self._publish_capture(agent)
+            for port in SENSORS:
+                if rt.due(agent, port.name):
+                    self._publish_sensor(agent, port)
 
     # ------------------------------------------------------------------ publishing
     def _now(self) -> float:
@@ -301,34 +304,22 @@ class SimNode(Node):
             pubs["last_room"] = room
             pubs["room"].publish(String(data=room or ""))
 
-    def _publish_scan(self, agent: Agent) -> None:
-        scan = self.runtime.scan(agent)
-        hdr = convert.header(self._now(), self._frame(agent, n.LASER_FRAME))
-        self.agent_pubs[agent.name]["scan"].publish(convert.laser_scan(
-            scan.ranges, scan.angle_min, scan.angle_increment, scan.range_min, scan.range_max,
-            scan.scan_time, hdr))
+    def _publish_sensor(self, agent: Agent, port: SensorPort) -> None:
+        """One reading of ``agent``'s sensor of ``port``: every topic of it with one stamp."""
+        data, pubs = self.runtime.read(agent, port.name), self.agent_pubs[agent.name]
+        frame = self._frame(agent, port.frame)
+        hdr = convert.header(self._now(), frame)
+        for topic in port.topics:
+            value = topic.value(data, agent.sensors[port.name], frame)
+            pubs[topic.key].publish(convert.KINDS[topic.kind].to_message(value, hdr))
 
-    def _publish_capture(self, agent: Agent, requested: bool = False) -> dict[str, Any]:
-        """One synchronised capture: RGB, JPEG, depth, instances and both camera_infos share one stamp.
-        A requested capture (the capture service) adds a scan with that stamp and an event on
-        ravh/capture (pose, room) so recorders can store it as one dataset sample."""
-        rt, pubs = self.runtime, self.agent_pubs[agent.name]
-        cap = rt.capture(agent)
-        hdr = convert.header(self._now(), self._frame(agent, n.CAMERA_OPTICAL_FRAME))
-        h, w = cap.rgb.shape[:2]
-        info = convert.camera_info(cap.K, w, h, hdr, cap.camera_info.D)
-        pubs["rgb"].publish(convert.image(cap.rgb, "rgb8", hdr))
-        pubs["rgb_info"].publish(info)
-        pubs["jpeg"].publish(convert.compressed(encode_jpeg(cap.rgb, agent.camera.options.jpeg_quality), hdr))
-        pubs["depth"].publish(convert.image(cap.depth, "32FC1", hdr))
-        pubs["depth_info"].publish(info)
-        pubs["instance"].publish(convert.image(cap.instance.astype("uint16"), "16UC1", hdr))
-        x, y, yaw = agent.robot.pose
-        event = {"agent": agent.name, "stamp": rt.time, "pose": [x, y, yaw], "room": rt.room_of(agent),
-                 "odom": list(agent.robot.odometry)}
-        if requested:
-            self._publish_scan(agent)
-            pubs["capture"].publish(String(data=json.dumps(event)))
+    def _publish_capture(self, agent: Agent) -> CaptureEvent:
+        """A requested capture: every sensor of the agent at one stamp, then the event on ravh/capture
+        (pose, room) so recorders can store it as one dataset sample."""
+        for port in SENSORS:
+            self._publish_sensor(agent, port)
+        event = self.runtime.capture_event(agent)
+        self.agent_pubs[agent.name]["capture"].publish(String(data=event.to_json()))
         return event
 
     # ------------------------------------------------------------------ map -> odom ownership
@@ -417,8 +408,8 @@ class SimNode(Node):
 
     def _on_capture(self, agent: Agent, response: Trigger.Response):
         try:
-            event = self._publish_capture(agent, requested=True)
-            response.success, response.message = True, json.dumps(event)
+            event = self._publish_capture(agent)
+            response.success, response.message = True, event.to_json()
         except Exception as e:  # never die from a request
             response.success, response.message = False, f"{type(e).__name__}: {e}"
         return response
@@ -443,9 +434,9 @@ def parse_args(argv: list[str]) -> dict[str, Any]:
     p.add_argument("--renderer", choices=BACKENDS)
     p.add_argument("--rtf", "--real-time-factor", dest="real_time_factor", type=float,
                    help="sim seconds per wall second; 0 = as fast as possible (default 1)")
-    p.add_argument("--camera-rate", dest="camera_rate", type=float)
-    p.add_argument("--scan-rate", dest="scan_rate", type=float)
-    p.add_argument("--odom-rate", dest="odom_rate", type=float)
+    for param in RATE_PARAMETERS:
+        p.add_argument("--" + param.replace("_", "-"), dest=param, type=float,
+                       help="Hz of sim time for every agent (default: its robot profile's; 0 = never)")
     p.add_argument("--cmd-vel-stamped", dest="cmd_vel_stamped", action="store_true", default=None)
     p.add_argument("--map-tf", dest="map_tf", choices=MAP_TF_MODES,
                    help="who publishes map -> odom on /tf: auto (default: the sim unless another node "

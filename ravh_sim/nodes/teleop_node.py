@@ -15,7 +15,7 @@ from std_srvs.srv import Trigger
 from ravh_msgs_py import names as n
 from ravh_sim.behaviours.teleop import HELP, Teleop
 from ravh_sim.errors import UserError
-from ravh_sim.nodes.behaviour_node import FIRST_AGENT
+from ravh_sim.nodes.behaviour_node import which_agent
 from ravh_sim.nodes.common import COMMAND_QOS, quiet_after_shutdown, run_node
 from ravh_sim.robot.profile import load_profile
 
@@ -23,12 +23,13 @@ PUBLISH_HZ = 10.0
 
 
 class TeleopNode(Node):
-    def __init__(self, agent: str, profile: str) -> None:
+    def __init__(self, agent: str | None, profile: str | None) -> None:
+        """``agent``: None drives the sim's first agent; ``profile``: None takes the agent's from the sim."""
         super().__init__("teleop")
         if not sys.stdin.isatty():
             raise UserError("teleop reads keys from a terminal; run it in an interactive shell")
-        first = agent == FIRST_AGENT
-        p = load_profile(profile)
+        agent, first, agent_profile = which_agent(self, agent)
+        p = load_profile(profile or agent_profile)
         self.teleop = Teleop(p.max_linear_speed, p.max_angular_speed)
         self.pub = self.create_publisher(Twist, n.agent_name(n.CMD_VEL, agent, first), COMMAND_QOS)
         self.capture = self.create_client(Trigger, n.agent_name(n.CAPTURE_SERVICE, agent, first))
@@ -61,8 +62,8 @@ class TeleopNode(Node):
 def main(argv: list[str] | None = None) -> int:
     def make(args: list[str]) -> TeleopNode:
         p = argparse.ArgumentParser(prog="teleop", description="Drive a robot with the keyboard.")
-        p.add_argument("--agent", default=FIRST_AGENT)
-        p.add_argument("--profile", default="giraff")
+        p.add_argument("--agent", default=None, help="agent to drive (default: the sim's first)")
+        p.add_argument("--profile", default=None, help="its robot profile (default: its profile in the sim)")
         a = p.parse_args(args)
         return TeleopNode(a.agent, a.profile)
     return run_node(make, argv)

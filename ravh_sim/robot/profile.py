@@ -14,10 +14,11 @@ from typing import Annotated, Any, Literal
 import yaml
 from pydantic import Field, model_validator
 
+from ravh_msgs_py.names import DEFAULT_PROFILE
 from ravh_sim.errors import FileFieldError, UnknownNameError
 from ravh_sim.paths import ROBOTS_DIR
 from ravh_sim.render.backend import QUALITIES
-from ravh_sim.schema import Strict, number, read_text, validate, vector
+from ravh_sim.schema import FINITE, Strict, read_text, validate
 
 
 @dataclass(frozen=True)
@@ -27,7 +28,7 @@ class LaserSpec:
     resolution_deg: float
     range_min: float
     range_max: float
-    rate: float              # Hz
+    rate: float              # Hz: scans published (and LaserScan.scan_time)
     noise_sigma: float       # m
 
     @property
@@ -51,7 +52,7 @@ class CameraSpec:
     focal_length: float      # mm
     near: float              # m
     far: float               # m
-    rate: float              # Hz
+    rate: float              # Hz: frames published
     quality: str = "realistic"   # realistic | fast (ravh_sim.render.backend.QUALITIES)
 
     @property
@@ -84,6 +85,7 @@ class RobotProfile:
     max_angular_acceleration: float  # rad/s^2
     odom_linear_sigma: float         # m per metre driven
     odom_angular_sigma: float        # rad per radian turned
+    odom_rate: float                 # Hz: odometry, ground-truth pose and /tf
     laser: LaserSpec
     camera: CameraSpec
     camera_effects: tuple[tuple[str, Any], ...] = ()   # CameraOptions fields set by the profile
@@ -95,22 +97,24 @@ def available_profiles() -> list[str]:
 
 # bounds: anything a real mobile robot could have; beyond them a value is a slip (a 1e6 m radius,
 # a 1e-7 degree laser resolution that would allocate gigabytes, a 0.5 px camera)
-Length = number(gt=0.0, le=10.0)           # m, body and mounting
-Rate = number(gt=0.0, le=1000.0)           # Hz
-Sigma = number(ge=0.0, le=10.0)
-Range = number(gt=0.0, le=1000.0)          # m
+Length = Annotated[float, Field(gt=0.0, le=10.0), FINITE]           # m, body and mounting
+Rate = Annotated[float, Field(gt=0.0, le=1000.0), FINITE]           # Hz
+Sigma = Annotated[float, Field(ge=0.0, le=10.0), FINITE]
+Range = Annotated[float, Field(gt=0.0, le=1000.0), FINITE]          # m
 Pixels = Annotated[int, Field(ge=16, le=8192)]
+Coefficient = Annotated[float, Field(ge=-10.0, le=10.0), FINITE]     # of lens distortion
 
 
-class _Noise(Strict):
+class _Odometry(Strict):
+    rate: Rate
     linear_sigma: Sigma
     angular_sigma: Sigma
 
 
 class _Laser(Strict):
     height: Length
-    fov: number(gt=0.0, le=360.0)
-    resolution: number(ge=0.01, le=360.0)
+    fov: Annotated[float, Field(gt=0.0, le=360.0), FINITE]
+    resolution: Annotated[float, Field(ge=0.01, le=360.0), FINITE]
     range_min: Range
     range_max: Range
     rate: Rate
@@ -126,26 +130,28 @@ class _Laser(Strict):
 
 
 class _Effects(Strict):
-    """The bounds of the realism effects the profile sets; their defaults live in sensors.camera.CameraOptions."""
-    jpeg_quality: Annotated[int, Field(ge=1, le=100)] = None
-    jpeg_roundtrip: bool = None
-    pixel_noise: number(ge=0.0, le=255.0) = None
-    distortion: vector(number(ge=-10.0, le=10.0), 5) | None = None
-    motion_blur: bool = None
-    exposure: number(gt=0.0, le=1.0) = None
-    depth_noise: number(ge=0.0, le=1.0) = None
-    manual_exposure: number(gt=0.0, le=100.0) | None = None
+    """The bounds of the realism effects the profile sets; their defaults live in sensors.camera.CameraOptions
+    (an effect left out or null takes that default)."""
+    jpeg_quality: Annotated[int, Field(ge=1, le=100)] | None = None
+    jpeg_roundtrip: bool | None = None
+    pixel_noise: Annotated[float, Field(ge=0.0, le=255.0), FINITE] | None = None
+    distortion: Annotated[tuple[Coefficient, Coefficient, Coefficient, Coefficient, Coefficient],
+                          Field(strict=False)] | None = None
+    motion_blur: bool | None = None
+    exposure: Annotated[float, Field(gt=0.0, le=1.0), FINITE] | None = None
+    depth_noise: Annotated[float, Field(ge=0.0, le=1.0), FINITE] | None = None
+    manual_exposure: Annotated[float, Field(gt=0.0, le=100.0), FINITE] | None = None
 
 
 class _Camera(Strict):
     height: Length
-    pitch: number(ge=-90.0, le=90.0)
-    forward: number(ge=-10.0, le=10.0)
+    pitch: Annotated[float, Field(ge=-90.0, le=90.0), FINITE]
+    forward: Annotated[float, Field(ge=-10.0, le=10.0), FINITE]
     width: Pixels
     height_px: Pixels
-    sensor_width: number(gt=0.0, le=100.0)     # mm
-    sensor_height: number(gt=0.0, le=100.0)
-    focal_length: number(gt=0.0, le=1000.0)
+    sensor_width: Annotated[float, Field(gt=0.0, le=100.0), FINITE]     # mm
+    sensor_height: Annotated[float, Field(gt=0.0, le=100.0), FINITE]
+    focal_length: Annotated[float, Field(gt=0.0, le=1000.0), FINITE]
     near: Range
     far: Range
     rate: Rate
@@ -164,17 +170,17 @@ class ProfileFile(Strict):
     name: Annotated[str, Field(min_length=1, max_length=64)]
     footprint_radius: Length
     height: Length
-    mass: number(gt=0.0, le=10_000.0)
-    max_linear_speed: number(gt=0.0, le=10.0)             # m/s
-    max_angular_speed: number(gt=0.0, le=1000.0)          # deg/s
-    max_linear_acceleration: number(gt=0.0, le=100.0)     # m/s^2
-    max_angular_acceleration: number(gt=0.0, le=10_000.0) # deg/s^2
-    odometry_noise: _Noise
+    mass: Annotated[float, Field(gt=0.0, le=10_000.0), FINITE]
+    max_linear_speed: Annotated[float, Field(gt=0.0, le=10.0), FINITE]             # m/s
+    max_angular_speed: Annotated[float, Field(gt=0.0, le=1000.0), FINITE]          # deg/s
+    max_linear_acceleration: Annotated[float, Field(gt=0.0, le=100.0), FINITE]     # m/s^2
+    max_angular_acceleration: Annotated[float, Field(gt=0.0, le=10_000.0), FINITE] # deg/s^2
+    odometry: _Odometry
     laser: _Laser
     camera: _Camera
 
 
-def load_profile(name_or_path: str | Path = "giraff") -> RobotProfile:
+def load_profile(name_or_path: str | Path = DEFAULT_PROFILE) -> RobotProfile:
     path = Path(name_or_path)
     if path.suffix not in (".yaml", ".yml"):
         path = ROBOTS_DIR / f"{name_or_path}.yaml"
@@ -191,10 +197,10 @@ def load_profile(name_or_path: str | Path = "giraff") -> RobotProfile:
         max_linear_speed=f.max_linear_speed, max_angular_speed=math.radians(f.max_angular_speed),
         max_linear_acceleration=f.max_linear_acceleration,
         max_angular_acceleration=math.radians(f.max_angular_acceleration),
-        odom_linear_sigma=f.odometry_noise.linear_sigma,
-        odom_angular_sigma=math.radians(f.odometry_noise.angular_sigma),
+        odom_linear_sigma=f.odometry.linear_sigma,
+        odom_angular_sigma=math.radians(f.odometry.angular_sigma), odom_rate=f.odometry.rate,
         laser=LaserSpec(lz.height, lz.fov, lz.resolution, lz.range_min, lz.range_max, lz.rate, lz.noise_sigma),
         camera=CameraSpec(cam.height, cam.pitch, cam.forward, cam.width, cam.height_px, cam.sensor_width,
                           cam.sensor_height, cam.focal_length, cam.near, cam.far, cam.rate, cam.quality),
-        camera_effects=tuple(sorted(effects.model_dump(exclude_unset=True).items())),
+        camera_effects=tuple(sorted(effects.model_dump(exclude_none=True).items())),
     )

@@ -20,6 +20,7 @@ import random
 
 import pybullet as pb
 
+from ravh_msgs_py.names import DEFAULT_AGENT
 from ravh_sim.poses import Pose2D, compose, relative, wrap_angle
 from ravh_sim.robot.profile import RobotProfile
 from ravh_sim.world.scene import World
@@ -88,7 +89,7 @@ class Robot:
     ``seed`` drives the odometry noise; by default it comes from the world's seed and the name.
     """
 
-    def __init__(self, world: World, profile: RobotProfile, name: str = "robot",
+    def __init__(self, world: World, profile: RobotProfile, name: str = DEFAULT_AGENT,
                  pose: Pose2D = (0.0, 0.0, 0.0), seed: int | None = None) -> None:
         self.world, self.profile, self.name = world, profile, name
         self._client = world.client

@@ -14,8 +14,9 @@ import numpy as np
 import pybullet as pb
 
 from ravh_sim.sensors.camera import Capture
-from ravh_sim.sensors.laser import Laser, Scan
+from ravh_sim.sensors.laser import Laser
 from ravh_sim.sensors.mount import floor_at
+from ravh_sim.sensors.readings import Scan
 
 CLASSES = {"walls": "walls", "object": "objects", "window": "objects", "door": "doors"}
 """Instance kind -> surface class reported."""
@@ -27,6 +28,7 @@ def laser_minus_depth(laser: Laser, scan: Scan, capture: Capture, pose: tuple[fl
     camera sees on the same instance; both sensors at robot pose ``pose``."""
     x, y, yaw = pose
     world = laser.world
+    assert scan.hit_bodies is not None, "agreement needs a simulated scan (with the bodies hit)"
     hit = np.isfinite(scan.ranges)
     angles = laser.angles[hit] + yaw
     z = floor_at(world, x, y) + laser.spec.height

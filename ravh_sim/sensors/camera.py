@@ -8,23 +8,29 @@ axis in metres (NaN where nothing is hit within ``far``); instance ids are the W
 On the TinyRenderer fallback a lighting pass (:mod:`lighting`) adds daylight colour, lamps and the
 sky. Optional effects (motion blur, lens distortion, noise, JPEG) follow in that order, seeded from
 the world seed, the agent and a capture counter so the same seed and poses give identical images.
+:data:`PORT` is the camera as a sensor port (ravh_sim.sensors.ports).
 """
 from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict, dataclass
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
 import pybullet as pb
 
+from ravh_msgs_py import names
+from ravh_sim.dataset import layout
 from ravh_sim.files import atomic_write, write_image
 from ravh_sim.poses import quaternion_from_matrix
 from ravh_sim.render.gl_renderer import GLRenderer
 from ravh_sim.render.projection import SAMPLE_OFFSET, projection_from_K, view_matrix
-from ravh_sim.robot.profile import CameraSpec
+from ravh_sim.robot.profile import CameraSpec, RobotProfile
+from ravh_sim.robot.robot import Robot
 from ravh_sim.sensors import imaging
 from ravh_sim.sensors.lighting import SUN_AMBIENT, SUN_DIFFUSE, Lighting
 from ravh_sim.sensors.mount import (
@@ -34,6 +40,8 @@ from ravh_sim.sensors.mount import (
     mount_position,
     mount_rotation,
 )
+from ravh_sim.sensors.ports import Mount, SensorPort, Stored, Topic, noise_rng
+from ravh_sim.sensors.readings import CameraInfo
 from ravh_sim.world.appearance import sun_light
 from ravh_sim.world.scene import World
 
@@ -52,19 +60,6 @@ class CameraOptions:
     exposure: float = 0.02                 # s, for motion blur
     depth_noise: float = 0.0               # sigma = depth_noise * z^2 (1/m)
     manual_exposure: float | None = None   # GL renderer: a fixed exposure instead of auto-exposure
-
-
-@dataclass(frozen=True)
-class CameraInfo:
-    """The fields of sensor_msgs/CameraInfo (row-major matrices)."""
-    frame_id: str
-    width: int
-    height: int
-    distortion_model: str
-    D: tuple[float, ...]
-    K: tuple[float, ...]
-    R: tuple[float, ...]
-    P: tuple[float, ...]
 
 
 @dataclass
@@ -94,8 +89,9 @@ class Capture:
 class SmartCamera:
     """A camera mounted on a robot, rendering one World."""
 
-    def __init__(self, world: World, spec: CameraSpec, options: CameraOptions | None = None) -> None:
-        self.world, self.spec = world, spec
+    def __init__(self, world: World, spec: CameraSpec, options: CameraOptions | None = None,
+                 agent: str = names.DEFAULT_AGENT) -> None:
+        self.world, self.spec, self.agent = world, spec, agent
         self.options = options or CameraOptions()
         self.width, self.height = spec.width, spec.height_px
         self.K = np.array([[spec.fx, 0.0, spec.cx], [0.0, spec.fy, spec.cy], [0.0, 0.0, 1.0]])
@@ -168,7 +164,7 @@ class SmartCamera:
         rgb, depth, instance = frame.rgb, frame.depth, frame.instance
         if self.lighting is not None:
             rgb = self._tiny_lighting(frame, sun)
-        rng = np.random.default_rng([state.seed, NOISE_STREAM, self.count])
+        rng = noise_rng(state.seed, NOISE_STREAM, self.agent, self.count)
         if opts.motion_blur and any(velocity):
             distance = float(np.nanmedian(depth)) if np.isfinite(depth).any() else self.spec.far
             rgb = imaging.motion_blur(rgb, self.K, velocity[0], velocity[1], opts.exposure, distance)
@@ -253,3 +249,63 @@ def write_capture(camera: SmartCamera, capture: Capture, directory: Path) -> lis
             "pixels_without_instance": int(counts[0]), "instances": visible}
     atomic_write(paths[3], (json.dumps(info, indent=1) + "\n").encode())
     return paths
+
+
+# ---------------------------------------------------------------------------- the camera as a port
+
+# camera_link (x forward, z up) -> optical frame (z forward, x right, y down), REP 103
+OPTICAL_ROTATION = quaternion_from_matrix(LINK_TO_OPTICAL)
+
+
+def _mounts(profile: RobotProfile) -> list[Mount]:
+    """camera_link on base_link from the same mount functions the camera renders with (TF and images
+    agree), and the optical frame on camera_link."""
+    cam = profile.camera
+    return [(names.BASE_FRAME, names.CAMERA_FRAME, tuple(mount_position(0.0, 0.0, 0.0, 0.0, cam.height, cam.forward)),
+             quaternion_from_matrix(mount_rotation(0.0, math.radians(cam.pitch_deg)))),
+            (names.CAMERA_FRAME, names.CAMERA_OPTICAL_FRAME, (0.0, 0.0, 0.0), OPTICAL_ROTATION)]
+
+
+def _store(values: Mapping[str, Any]) -> Stored:
+    """PNGs of colour, depth (16-bit mm) and instances; the intrinsics go to camera.json."""
+    rgb, depth, instance, info = values["rgb"], values["depth"], values["instance"], values["rgb_info"]
+    h, w = rgb.shape[:2]
+    if rgb.shape != (h, w, 3) or depth.shape != (h, w) or instance.shape != (h, w):
+        raise ValueError(f"image shapes differ: rgb {rgb.shape}, depth {depth.shape}, instance {instance.shape}")
+    if instance.size and (instance.min() < 0 or instance.max() > np.iinfo(np.uint16).max):
+        raise ValueError("instance ids must fit in 16 bits")
+    intrinsics = {"width": info.width, "height": info.height, "K": list(info.K), "D": list(info.D),
+                  "distortion_model": info.distortion_model, "frame_id": info.frame_id}
+    return Stored({"rgb": layout.encode_png(np.ascontiguousarray(rgb, np.uint8)),
+                   "depth": layout.encode_png(imaging.depth_to_png(depth)),
+                   "mask": layout.encode_png(instance.astype(np.uint16))},
+                  agent_facts={layout.CAMERA_JSON: intrinsics})
+
+
+def _build(world: World, profile: RobotProfile, agent: str) -> SmartCamera:
+    return SmartCamera(world, profile.camera, CameraOptions(**dict(profile.camera_effects)), agent)
+
+
+def _read(camera: SmartCamera, robot: Robot) -> Capture:
+    x, y, yaw = robot.pose
+    return camera.capture(x, y, yaw, velocity=robot.velocity)
+
+
+def _info(capture: Capture, camera: SmartCamera, frame: str) -> CameraInfo:
+    return replace(capture.camera_info, frame_id=frame)
+
+
+PORT = SensorPort(
+    name="camera", frame=names.CAMERA_OPTICAL_FRAME, captured=True,
+    topics=(
+        Topic("rgb", names.COLOR_IMAGE, "rgb8", dataset=True, bag=False, value=lambda cap, cam, frame: cap.rgb),
+        Topic("rgb_info", names.COLOR_INFO, "camera_info", dataset=True, bag=True, value=_info),
+        Topic("jpeg", names.COLOR_COMPRESSED, "jpeg", dataset=False, bag=True,
+              value=lambda cap, cam, frame: imaging.encode_jpeg(cap.rgb, cam.options.jpeg_quality)),
+        Topic("depth", names.DEPTH_IMAGE, "32FC1", dataset=True, bag=True, value=lambda cap, cam, frame: cap.depth),
+        Topic("depth_info", names.DEPTH_INFO, "camera_info", dataset=False, bag=True, value=_info),
+        Topic("instance", names.INSTANCE_IMAGE, "16UC1", dataset=True, bag=True,
+              value=lambda cap, cam, frame: cap.instance.astype(np.uint16)),
+    ),
+    files={"rgb": ".png", "depth": ".png", "mask": ".png"}, rate=lambda profile: profile.camera.rate, mounts=_mounts,
+    build=_build, read=_read, store=_store)

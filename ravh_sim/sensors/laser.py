@@ -7,19 +7,26 @@ bodies sit in collision groups that the rays' mask leaves out (:meth:`World.ray_
 ever hits them, wherever it starts (a ray starting inside a convex body may or may not hit it).
 Open doors are moved out of the house by the World, so the laser sees through open doorways;
 closed doors, walls and furniture parts (legs, not their bounding boxes) stop it. Noise is
-Gaussian, seeded from the world seed and a scan counter.
+Gaussian, seeded from the world seed, the agent and a scan counter. :data:`PORT` is the laser as a
+sensor port (ravh_sim.sensors.ports).
 """
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping
+from typing import Any
 
 import numpy as np
 import pybullet as pb
 
-from ravh_sim.robot.profile import LaserSpec
-from ravh_sim.sensors.mount import LASER_FRAME, floor_at
+from ravh_msgs_py import names
+from ravh_sim.dataset import layout
+from ravh_sim.poses import quaternion_from_matrix
+from ravh_sim.robot.profile import LaserSpec, RobotProfile
+from ravh_sim.robot.robot import Robot
+from ravh_sim.sensors.mount import LASER_FRAME, floor_at, mount_position, mount_rotation
+from ravh_sim.sensors.ports import Mount, SensorPort, Stored, Topic, noise_rng
+from ravh_sim.sensors.readings import Scan
 from ravh_sim.world.scene import World
 
 NOISE_STREAM = 2            # noise generator stream of lasers (cameras use another)
@@ -27,27 +34,11 @@ STAGES = (1.5, 4.0, 10.0)   # m: ray lengths of the first cast stages (then rang
 STAGE_OVERLAP = 0.01        # m: a stage starts this much before the previous one ended
 
 
-@dataclass
-class Scan:
-    """The fields of sensor_msgs/LaserScan."""
-    frame_id: str
-    angle_min: float
-    angle_max: float
-    angle_increment: float
-    time_increment: float
-    scan_time: float
-    range_min: float
-    range_max: float
-    ranges: np.ndarray                     # float32, REP 117: +inf no return, -inf too close
-    hit_bodies: np.ndarray                 # int32 pybullet body per ray, -1 none (ground truth)
-    index: int
-
-
 class Laser:
     """A planar laser scanner mounted at the robot's base centre."""
 
-    def __init__(self, world: World, spec: LaserSpec) -> None:
-        self.world, self.spec = world, spec
+    def __init__(self, world: World, spec: LaserSpec, agent: str = names.DEFAULT_AGENT) -> None:
+        self.world, self.spec, self.agent = world, spec, agent
         n = spec.ray_count
         increment = math.radians(spec.resolution_deg)
         if spec.fov_deg >= 360.0 - 1e-9:
@@ -70,7 +61,7 @@ class Laser:
         bodies, distances = self._trace(np.array([x, y, z]), directions, self.world.ray_mask(ignore_bodies))
         ranges = distances.astype(np.float32)
         if spec.noise_sigma > 0:
-            rng = np.random.default_rng([self.world.state.seed, NOISE_STREAM, self.count])
+            rng = noise_rng(self.world.state.seed, NOISE_STREAM, self.agent, self.count)
             noisy = ranges + rng.standard_normal(len(ranges)).astype(np.float32) * spec.noise_sigma
             ranges = np.where(np.isfinite(ranges), np.clip(noisy, spec.range_min, spec.range_max), ranges)
         ranges[ranges < spec.range_min] = -np.inf
@@ -103,3 +94,35 @@ class Laser:
             if not todo.size:
                 break
         return bodies, distances
+
+
+# ---------------------------------------------------------------------------- the laser as a port
+
+def float32(value: float) -> float:
+    """``value`` as a float32 field of LaserScan carries it, so a sample stores the same numbers
+    whether it was read here or decoded from the topic."""
+    return float(np.float32(value))
+
+
+def _mounts(profile: RobotProfile) -> list[Mount]:
+    return [(names.BASE_FRAME, names.LASER_FRAME, tuple(mount_position(0.0, 0.0, 0.0, 0.0, profile.laser.height)),
+             quaternion_from_matrix(mount_rotation(0.0)))]
+
+
+def _store(values: Mapping[str, Any]) -> Stored:
+    scan: Scan = values["scan"]
+    meta = {k: float32(getattr(scan, k)) for k in ("angle_min", "angle_increment", "range_min", "range_max")}
+    return Stored({"scan": layout.encode_scan(scan.ranges, meta["angle_min"], meta["angle_increment"])},
+                  row={"scan": meta})
+
+
+def _read(laser: Laser, robot: Robot) -> Scan:
+    x, y, yaw = robot.pose
+    return laser.scan(x, y, yaw, ignore_bodies=(robot.body,))
+
+
+PORT = SensorPort(
+    name="scan", frame=names.LASER_FRAME, captured=False,
+    topics=(Topic("scan", names.SCAN, "laser_scan", dataset=True, bag=True, value=lambda scan, laser, frame: scan),),
+    files={"scan": ".npy"}, rate=lambda profile: profile.laser.rate, mounts=_mounts,
+    build=lambda world, profile, agent: Laser(world, profile.laser, agent), read=_read, store=_store)

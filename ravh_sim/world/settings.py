@@ -23,6 +23,7 @@ import yaml
 from pydantic import AfterValidator, Field
 
 from ravh_msgs_py.appearance import DOOR, SEED_MAX, SUN_PRESETS, SWITCH
+from ravh_msgs_py.names import DEFAULT_PROFILE
 from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
 from ravh_sim.paths import DEFAULT_CONFIG, ROBOTS_DIR
 from ravh_sim.schema import Strict, read_text, shown, validate
@@ -113,7 +114,7 @@ class _Models(Strict):
 class _Agent(Strict):
     # no name: robot<i>; an explicit null is refused (the default is not validated, the value is)
     name: Annotated[str, Field(default=None, min_length=1, max_length=64, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")]
-    profile: Annotated[str, Field(min_length=1, max_length=64)] = "giraff"
+    profile: Annotated[str, Field(min_length=1, max_length=64)] = DEFAULT_PROFILE
     start: _checked(_check_start) = "station"
 
 
@@ -340,7 +341,7 @@ def _resolve_agents(cfg: list[dict], house: House, source: str) -> tuple[AgentSp
         if name in names:
             raise FileFieldError(source, f"agents[{i}].name", f"duplicate agent name {name!r}")
         names.add(name)
-        profile = a.get("profile", "giraff")
+        profile = a.get("profile", DEFAULT_PROFILE)
         if not (ROBOTS_DIR / f"{profile}.yaml").exists():
             valid = sorted(p.stem for p in ROBOTS_DIR.glob("*.yaml"))
             raise FileFieldError(source, f"agents[{i}].profile", str(UnknownNameError("robot profile",
