@@ -61,3 +61,11 @@ def quaternion_from_matrix(r: np.ndarray) -> Quaternion:
     sign = 1.0 if q[3] >= 0 else -1.0
     x, y, z, w = (float(sign * v) for v in q)
     return (x, y, z, w)
+
+
+def matrix_from_quaternion(q: Quaternion) -> np.ndarray:
+    """The 3x3 rotation matrix of a unit quaternion (x, y, z, w)."""
+    x, y, z, w = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])

@@ -117,3 +117,24 @@ def test_the_cycle_finder_finds_a_cycle():
     graph = {"a": {"b"}, "b": {"c"}, "c": {"b", "d"}, "d": set()}
     assert find_cycle(graph) == ["b", "c", "b"]
     assert find_cycle({"a": {"b"}, "b": {"c"}, "c": set()}) is None
+
+
+# --------------------------------------------------------------------------- who talks to pybullet
+
+# The World owns the client (bodies of the house, ray casts); a robot builds and drives its own body
+# on it, the Simulation steps it, and the TinyRenderer draws through it. Nothing else calls pybullet:
+# sensors ask the World or a renderer (ravh_sim.render), so a physics or renderer change stays there.
+PYBULLET_OWNERS = {"ravh_sim.world.scene", "ravh_sim.robot.robot", "ravh_sim.robot.simulation",
+                   "ravh_sim.render.tiny_renderer"}
+
+
+def _imports_pybullet(path: Path) -> bool:
+    return any(isinstance(node, ast.Import) and any(a.name == "pybullet" for a in node.names)
+               or isinstance(node, ast.ImportFrom) and node.module == "pybullet"
+               for node in ast.walk(ast.parse(path.read_text(), str(path))))
+
+
+def test_only_the_client_owners_import_pybullet():
+    users = {name for name, path in _modules().items() if _imports_pybullet(path)}
+    assert "ravh_sim.world.scene" in users
+    assert users == PYBULLET_OWNERS

@@ -22,9 +22,10 @@ from ravh_sim.nav.follower import PathFollower, Status
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.nav.planner import Unreachable
 from ravh_sim.poses import quaternion_from_matrix
+from ravh_sim.render.projection import projection_from_K
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.robot.simulation import Simulation
-from ravh_sim.sensors.camera import CameraOptions, SmartCamera, projection_from_K
+from ravh_sim.sensors.camera import CameraOptions, SmartCamera
 from ravh_sim.sensors.imaging import encode_jpeg, jpeg_roundtrip
 from ravh_sim.sensors.laser import Laser
 from ravh_sim.sensors.mount import LINK_TO_OPTICAL

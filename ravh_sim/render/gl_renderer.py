@@ -17,7 +17,6 @@ surface facing it at noon, a lamp of intensity 1 gives LAMP_POWER / d^2.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from importlib import resources
 from typing import TYPE_CHECKING
 
@@ -28,6 +27,7 @@ from ravh_sim.render.backend import gl_context
 from ravh_sim.render.geometry import ATTRIBUTES, VERTEX_FORMAT, SceneBuilder
 from ravh_sim.render.materials import NOISE_TEXELS, PATTERN, TEXELS, MaterialTable, noise_volume, srgb8_to_linear
 from ravh_sim.render.projection import look_at, orthographic, perspective, projection_from_K, view_matrix
+from ravh_sim.render.views import RenderedViews
 from ravh_sim.world.appearance import SunLight, sun_light
 from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import Light
@@ -67,14 +67,6 @@ EXPOSURE_REFERENCE = 0.5              # log-average luminance of a daylit room
 EXPOSURE_ADAPTATION = 0.5             # how much of a brightness change exposure undoes (1 = all)
 EXPOSURE_RANGE = (0.08, 5.0)          # a camera's exposure limits: night stays dark
 METER_BLOCK = 16                      # pixels per side averaged by one metering texel
-
-
-@dataclass
-class RenderedViews:
-    rgb: np.ndarray                   # (H, W, 3) uint8, tone-mapped sRGB
-    depth: np.ndarray                 # (H, W) float32 z-depth in metres, NaN = nothing
-    instance: np.ndarray              # (H, W) uint16, 0 = nothing
-    background: np.ndarray            # (H, W) bool: the outdoors (sky, ground), no body
 
 
 def _source(name: str) -> str:

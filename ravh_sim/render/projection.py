@@ -9,9 +9,6 @@ import math
 
 import numpy as np
 
-# Where each renderer samples a pixel, measured against K: OpenGL samples pixel centres;
-# TinyRenderer samples pixel corners, and its flipped rows are one pixel off.
-SAMPLE_OFFSET = {"gl": (0.5, 0.5), "tiny": (0.0, 1.0)}
 # Optical frame -> OpenGL eye frame (x right, y up, z backwards).
 OPTICAL_TO_GL = np.diag([1.0, -1.0, -1.0])
 

@@ -11,8 +11,8 @@ sees.
 from __future__ import annotations
 
 import numpy as np
-import pybullet as pb
 
+from ravh_sim.poses import matrix_from_quaternion
 from ravh_sim.sensors.camera import Capture
 from ravh_sim.sensors.laser import Laser
 from ravh_sim.sensors.mount import floor_at
@@ -34,7 +34,7 @@ def laser_minus_depth(laser: Laser, scan: Scan, capture: Capture, pose: tuple[fl
     z = floor_at(world, x, y) + laser.spec.height
     points = np.stack([x + scan.ranges[hit] * np.cos(angles), y + scan.ranges[hit] * np.sin(angles),
                        np.full(hit.sum(), z)], axis=1)
-    rotation = np.array(pb.getMatrixFromQuaternion(capture.orientation)).reshape(3, 3)
+    rotation = matrix_from_quaternion(capture.orientation)
     local = (points - capture.position) @ rotation            # optical frame: x right, y down, z ahead
     ahead = local[:, 2] > 1e-6
     uv = local[:, :2] / np.where(ahead, local[:, 2], 1.0)[:, None] * np.diag(capture.K)[:2] + capture.K[:2, 2]

@@ -1,13 +1,13 @@
 """The smart camera: RGB, depth and instance images from one render, pinhole-exact.
 
-The renderer (ravh_sim.render: our physically based GL renderer, or pybullet's TinyRenderer where
-no GL context can be made) draws RGB, depth and instance ids from the same triangles with a
-projection built from K, so a 3D point projected with K lands on the pixel where it is drawn (OpenCV
+A renderer (ravh_sim.render.renderers.make_renderer: our physically based GL renderer, or pybullet's
+TinyRenderer where no GL context can be made) draws lit RGB, depth and instance ids from the same
+triangles with a projection built from K, so a 3D point projected with K lands on the pixel where it is drawn (OpenCV
 pixel convention: pixel i covers [i - 0.5, i + 0.5]). Depth is REP 118 z-depth along the optical
 axis in metres (NaN where nothing is hit within ``far``); instance ids are the World's (0 = nothing).
-On the TinyRenderer fallback a lighting pass (:mod:`lighting`) adds daylight colour, lamps and the
-sky. Optional effects (motion blur, lens distortion, noise, JPEG) follow in that order, seeded from
-the world seed, the agent and a capture counter so the same seed and poses give identical images.
+The camera never talks GL or pybullet. Optional effects (motion blur, lens distortion, noise, JPEG)
+follow in that order, seeded from the world seed, the agent and a capture counter so the same seed
+and poses give identical images.
 :data:`PORT` is the camera as a sensor port (ravh_sim.sensors.ports).
 """
 from __future__ import annotations
@@ -21,18 +21,16 @@ from typing import Any
 
 import cv2
 import numpy as np
-import pybullet as pb
 
 from ravh_msgs_py import names
 from ravh_sim.dataset import layout
 from ravh_sim.files import atomic_write, write_image
 from ravh_sim.poses import quaternion_from_matrix
-from ravh_sim.render.gl_renderer import GLRenderer
-from ravh_sim.render.projection import SAMPLE_OFFSET, projection_from_K, view_matrix
+from ravh_sim.render.renderers import make_renderer
+from ravh_sim.render.views import Renderer
 from ravh_sim.robot.profile import CameraSpec, RobotProfile
 from ravh_sim.robot.robot import Robot
 from ravh_sim.sensors import imaging
-from ravh_sim.sensors.lighting import SUN_AMBIENT, SUN_DIFFUSE, Lighting
 from ravh_sim.sensors.mount import (
     CAMERA_OPTICAL_FRAME,
     LINK_TO_OPTICAL,
@@ -42,7 +40,6 @@ from ravh_sim.sensors.mount import (
 )
 from ravh_sim.sensors.ports import Mount, SensorPort, Stored, Topic, noise_rng
 from ravh_sim.sensors.readings import CameraInfo
-from ravh_sim.world.appearance import sun_light
 from ravh_sim.world.scene import World
 
 DISTORTION_MODEL = "plumb_bob"
@@ -64,7 +61,7 @@ class CameraOptions:
 
 @dataclass
 class Frame:
-    """One render, before effects (on the TinyRenderer fallback also before its lighting pass)."""
+    """One render, before effects."""
     rgb: np.ndarray                        # (H, W, 3) uint8
     depth: np.ndarray                      # (H, W) float32 z-depth, NaN = nothing
     instance: np.ndarray                   # (H, W) uint16
@@ -95,15 +92,11 @@ class SmartCamera:
         self.options = options or CameraOptions()
         self.width, self.height = spec.width, spec.height_px
         self.K = np.array([[spec.fx, 0.0, spec.cx], [0.0, spec.fy, spec.cy], [0.0, 0.0, 1.0]])
-        self.projection = projection_from_K(self.K, self.width, self.height, spec.near, spec.far,
-                                            SAMPLE_OFFSET[world.renderer])
         self.camera_info = self._camera_info()
-        self._gl_projection = self.projection.T.ravel().tolist()      # column-major for pybullet
         self._lens = (imaging.LensDistortion(self.K, self.options.distortion, self.width, self.height)
                       if self.options.distortion is not None else None)
-        self.gl = (GLRenderer(world, self.K, self.width, self.height, spec.near, spec.far, spec.quality)
-                   if world.renderer == "gl" else None)
-        self.lighting = Lighting(world, self.K, self.width, self.height) if self.gl is None else None
+        self.renderer: Renderer | None = make_renderer(world, self.K, self.width, self.height, spec.near,
+                                                       spec.far, spec.quality)
         self._instance_rgb = np.zeros((max(i.id for i in world.instances) + 1, 3), np.uint8)
         for inst in world.instances:
             self._instance_rgb[inst.id] = inst.mask_color
@@ -113,9 +106,9 @@ class SmartCamera:
 
     def close(self) -> None:
         """Free the camera's GPU objects (a World's cameras are closed with it)."""
-        if self.gl is not None:
-            self.gl.release()
-            self.gl = None
+        if self.renderer is not None:
+            self.renderer.release()
+            self.renderer = None
 
     # ------------------------------------------------------------------ geometry
     def optical_pose(self, x: float, y: float, yaw: float, floor_z: float | None = None
@@ -147,24 +140,18 @@ class SmartCamera:
     def render(self, x: float, y: float, yaw: float, floor_z: float | None = None) -> Frame:
         """The render from robot pose (x, y, yaw), before effects."""
         position, rotation = self.optical_pose(x, y, yaw, floor_z)
-        if self.gl is not None:
-            views = self.gl.render(position, rotation, self.options.manual_exposure)
-            return Frame(views.rgb, views.depth, views.instance, views.background, position, rotation)
-        rgb, depth, instance, background = self._render(position, rotation,
-                                                         sun_light(self.world.state.sun_angle).direction)
-        return Frame(rgb, depth, instance, background, position, rotation)
+        if self.renderer is None:
+            raise RuntimeError("the camera was closed")
+        views = self.renderer.render(position, rotation, self.options.manual_exposure)
+        return Frame(views.rgb, views.depth, views.instance, views.background, position, rotation)
 
     def capture(self, x: float, y: float, yaw: float, floor_z: float | None = None,
                 velocity: tuple[float, float] = (0.0, 0.0)) -> Capture:
         """Render the view from robot pose (x, y, yaw); ``velocity`` (v m/s, w rad/s) for motion blur."""
         opts = self.options
-        state = self.world.state
-        sun = sun_light(state.sun_angle)
         frame = self.render(x, y, yaw, floor_z)
         rgb, depth, instance = frame.rgb, frame.depth, frame.instance
-        if self.lighting is not None:
-            rgb = self._tiny_lighting(frame, sun)
-        rng = noise_rng(state.seed, NOISE_STREAM, self.agent, self.count)
+        rng = noise_rng(self.world.state.seed, NOISE_STREAM, self.agent, self.count)
         if opts.motion_blur and any(velocity):
             distance = float(np.nanmedian(depth)) if np.isfinite(depth).any() else self.spec.far
             rgb = imaging.motion_blur(rgb, self.K, velocity[0], velocity[1], opts.exposure, distance)
@@ -183,39 +170,9 @@ class SmartCamera:
         self.count += 1
         return capture
 
-    def _tiny_lighting(self, frame: Frame, sun) -> np.ndarray:
-        """The TinyRenderer fallback's lighting pass: daylight, lamps, sky in the background."""
-        assert self.lighting is not None
-        lights = [lt for lt in self.world.house.lights if self.world.state.lights.get(lt.id, False)]
-        rgb = self.lighting.apply(frame.rgb, frame.depth, frame.instance, frame.rotation, frame.position,
-                                  sun, lights)
-        if frame.background.any():
-            rgb[frame.background] = sun.sky
-        return rgb
-
     def instance_color(self, capture: Capture) -> np.ndarray:
         """(H, W, 3) uint8 image of the instance ids in their footprint mask colours (black = nothing)."""
         return self._instance_rgb[capture.instance]
-
-    def _render(self, position: np.ndarray, rotation: np.ndarray, light_direction
-                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """One TinyRenderer render: (rgb uint8, z-depth float32, instance uint16, background mask)."""
-        view = view_matrix(position, rotation)
-        _, _, rgba, buffer, seg = pb.getCameraImage(
-            self.width, self.height, view.T.ravel().tolist(), self._gl_projection,
-            physicsClientId=self.world.client, lightDirection=list(light_direction),
-            renderer=pb.ER_TINY_RENDERER, shadow=0, lightColor=[1.0, 1.0, 1.0],
-            lightAmbientCoeff=SUN_AMBIENT, lightDiffuseCoeff=SUN_DIFFUSE, lightSpecularCoeff=0.0)
-        rgba = np.asarray(rgba, np.uint8).reshape(self.height, self.width, 4)
-        buffer = np.asarray(buffer, np.float32).reshape(self.height, self.width)
-        seg = np.asarray(seg, np.int32).reshape(self.height, self.width)
-        background = seg < 0
-        near, far = self.spec.near, self.spec.far
-        depth = (far * near) / (far - (far - near) * buffer)
-        depth[background | (buffer >= 1.0)] = np.nan
-        lut = np.append(self.world.body_to_instance_lut(), 0).astype(np.uint16)  # seg -1 -> last entry
-        instance = np.take(lut, seg, mode="wrap")
-        return cv2.cvtColor(rgba, cv2.COLOR_RGBA2RGB), depth, instance, background
 
     def _camera_info(self) -> CameraInfo:
         k = self.K

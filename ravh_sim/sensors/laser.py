@@ -1,6 +1,6 @@
 """The laser scanner: one horizontal fan of rays through pybullet's collision world (REP 117 ranges).
 
-Rays go out from the laser height in a few ``rayTestBatch`` calls of growing length (see
+Rays go out from the laser height in a few ray batches (:meth:`World.cast_rays`) of growing length (see
 :meth:`Laser._trace`). Ranges follow REP 117: +inf where nothing is hit within ``range_max``, -inf
 where the hit is closer than ``range_min``. The robot's own body must not shadow the scan: ignored
 bodies sit in collision groups that the rays' mask leaves out (:meth:`World.ray_mask`), so no ray
@@ -17,7 +17,6 @@ from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
-import pybullet as pb
 
 from ravh_msgs_py import names
 from ravh_sim.dataset import layout
@@ -83,11 +82,10 @@ class Laser:
         bodies, distances = np.full(n, -1, np.int64), np.full(n, np.inf)
         todo, start = np.arange(n), 0.0
         for end in [e for e in STAGES if e < self.spec.range_max] + [self.spec.range_max]:
-            hits = pb.rayTestBatch(origin + directions[todo] * start, origin + directions[todo] * end,
-                                   collisionFilterMask=mask, physicsClientId=self.world.client)
-            body = np.fromiter((h[0] for h in hits), np.int64, len(hits))
+            body, points = self.world.cast_rays(origin + directions[todo] * start,
+                                                origin + directions[todo] * end, mask)
             found = body >= 0
-            point = np.array([h[3] for h in hits])[found]
+            point = points[found]
             bodies[todo[found]] = body[found]
             distances[todo[found]] = np.einsum("ij,ij->i", point - origin, directions[todo[found]])
             todo, start = todo[~found], end - STAGE_OVERLAP

@@ -140,6 +140,16 @@ class World:
             mask &= ~self._ray_groups[body]
         return mask
 
+    def cast_rays(self, starts: np.ndarray, ends: np.ndarray, mask: int = ALL_GROUPS
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """(first body hit or -1, hit point) per ray from ``starts`` (N, 3) to ``ends`` (N, 3), among
+        the bodies ``mask`` sees (:meth:`ray_mask`); points of rays that hit nothing are NaN."""
+        hits = pb.rayTestBatch(starts, ends, collisionFilterMask=mask, physicsClientId=self.client)
+        bodies = np.fromiter((h[0] for h in hits), np.int64, len(hits))
+        points = np.array([h[3] for h in hits], np.float64).reshape(-1, 3)
+        points[bodies < 0] = np.nan
+        return bodies, points
+
     # ------------------------------------------------------------------ building
     def _build(self) -> None:
         # The ground: a thin slab just under the floors (the robot drives on it; it also shows as the

@@ -1,0 +1,60 @@
+"""pybullet's TinyRenderer, the fallback where no GL context can be made (and the speed baseline).
+
+pybullet draws the World's bodies with one directional light (the sun's direction) and fixed shading;
+:mod:`tiny_lighting` then adds daylight colour and the switched-on lamps per room, and the sky fills
+the background. TinyRenderer samples pixel corners and flips rows one pixel off, so its projection
+is built from K with that sample offset and its pixels still match K exactly.
+"""
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pybullet as pb
+
+from ravh_sim.render.projection import projection_from_K, view_matrix
+from ravh_sim.render.tiny_lighting import SUN_AMBIENT, SUN_DIFFUSE, Lighting
+from ravh_sim.render.views import RenderedViews
+from ravh_sim.world.appearance import sun_light
+from ravh_sim.world.scene import World
+
+SAMPLE_OFFSET = (0.0, 1.0)        # where TinyRenderer samples pixel (u, v), measured against K
+
+
+class TinyRenderer:
+    """Renders one World for one camera model (K, size, clip planes) with pybullet's TinyRenderer."""
+
+    def __init__(self, world: World, K: np.ndarray, width: int, height: int, near: float, far: float
+                 ) -> None:
+        self.world, self.width, self.height, self.near, self.far = world, width, height, near, far
+        projection = projection_from_K(K, width, height, near, far, SAMPLE_OFFSET)
+        self._projection = projection.T.ravel().tolist()          # column-major for pybullet
+        self.lighting = Lighting(world, K, width, height)
+
+    def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None
+               ) -> RenderedViews:
+        """Views from an optical pose; ``exposure`` is ignored (the lighting pass sets the level)."""
+        state = self.world.state
+        sun = sun_light(state.sun_angle)
+        view = view_matrix(position, rotation)
+        _, _, rgba, buffer, seg = pb.getCameraImage(
+            self.width, self.height, view.T.ravel().tolist(), self._projection,
+            physicsClientId=self.world.client, lightDirection=list(sun.direction),
+            renderer=pb.ER_TINY_RENDERER, shadow=0, lightColor=[1.0, 1.0, 1.0],
+            lightAmbientCoeff=SUN_AMBIENT, lightDiffuseCoeff=SUN_DIFFUSE, lightSpecularCoeff=0.0)
+        rgba = np.asarray(rgba, np.uint8).reshape(self.height, self.width, 4)
+        buffer = np.asarray(buffer, np.float32).reshape(self.height, self.width)
+        seg = np.asarray(seg, np.int32).reshape(self.height, self.width)
+        background = seg < 0
+        depth = (self.far * self.near) / (self.far - (self.far - self.near) * buffer)
+        depth[background | (buffer >= 1.0)] = np.nan
+        lut = np.append(self.world.body_to_instance_lut(), 0).astype(np.uint16)  # seg -1 -> last entry
+        instance = np.take(lut, seg, mode="wrap")
+        lights = [lt for lt in self.world.house.lights if state.lights.get(lt.id, False)]
+        rgb = self.lighting.apply(cv2.cvtColor(rgba, cv2.COLOR_RGBA2RGB), depth, instance, rotation,
+                                  position, sun, lights)
+        if background.any():
+            rgb[background] = sun.sky
+        return RenderedViews(rgb, depth, instance, background)
+
+    def release(self) -> None:
+        """Nothing to free: pybullet's client belongs to the World."""
