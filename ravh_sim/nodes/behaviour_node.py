@@ -44,7 +44,7 @@ from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.planner import Path as PlannedPath
 from ravh_sim.nav.planner import plan_path
 from ravh_sim.nodes import convert
-from ravh_sim.nodes.common import COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, STATE_QOS, SimWatchdog, quiet_after_shutdown
+from ravh_sim.nodes.common import COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, STATE_QOS, SimWatchdog
 from ravh_sim.poses import Pose2D, yaw_from_quaternion
 from ravh_sim.robot.profile import load_profile
 
@@ -162,7 +162,6 @@ class BehaviourNode(Node):
         raise UserError(f"no sim node answered within {STARTUP_TIMEOUT_S:.0f} s "
                         f"(is `ravh sim` running on ROS_DOMAIN_ID {os.environ.get('ROS_DOMAIN_ID', '0')}?)")
 
-    @quiet_after_shutdown
     def _tick(self) -> None:
         """Sim-time timer (not lockstep): one control step, unless holding for the recorder."""
         now = self.get_clock().now().nanoseconds * 1e-9

@@ -47,7 +47,6 @@ from ravh_sim.nodes.common import (
     LATCHED_QOS,
     SENSOR_QOS,
     STATE_QOS,
-    quiet_after_shutdown,
     run_node,
 )
 from ravh_sim.render.backend import BACKENDS
@@ -168,7 +167,6 @@ class SimNode(Node):
                 lambda req, res, a=agent: self._on_capture(a, res))
 
     # ------------------------------------------------------------------ stepping
-    @quiet_after_shutdown
     def _tick(self) -> None:
         """Advance sim time towards wall time x RTF, publishing whatever falls due on the way."""
         rt = self.runtime
