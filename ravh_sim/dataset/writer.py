@@ -39,7 +39,7 @@ class DatasetWriter:
             if (self.dir / layout.DATASET_JSON).exists():
                 raise UserError(f"{self.dir} already holds a dataset; record into a new folder")
             try:
-                self._rows = open(self.dir / layout.CAPTURES_JSONL, "x", encoding="utf-8")
+                self._rows = open(self.dir / layout.CAPTURES_JSONL, "xb", buffering=0)
             except FileExistsError:
                 raise UserError(f"{self.dir} already holds {layout.CAPTURES_JSONL}; record into a new folder") from None
             for folder, _ in layout.CAPTURE_FILES.values():
@@ -115,11 +115,23 @@ class DatasetWriter:
                "room": room, "room_type": self._room_types.get(room) if room else None,
                "files": files, "scan": {k: float(scan_meta[k]) for k in
                                         ("angle_min", "angle_increment", "range_min", "range_max")}}
-        self._rows.write(json.dumps(row) + "\n")
-        self._rows.flush()
-        os.fsync(self._rows.fileno())
+        self._append_row((json.dumps(row) + "\n").encode())
         self.count += 1
         return index
+
+    def _append_row(self, line: bytes) -> None:
+        """Append one line to captures.jsonl and fsync it; a write that fails part-way (a full disk)
+        is cut off again, so the file never holds a torn line that a later line would follow."""
+        start = self._rows.tell()
+        try:
+            done = 0
+            while done < len(line):
+                done += self._rows.write(line[done:])
+            os.fsync(self._rows.fileno())
+        except OSError:
+            os.ftruncate(self._rows.fileno(), start)
+            self._rows.seek(start)
+            raise
 
     def close(self) -> None:
         self._rows.close()

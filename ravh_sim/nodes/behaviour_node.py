@@ -261,8 +261,7 @@ class BehaviourNode(Node):
             self._log_file.flush()
 
     def close(self) -> None:
-        if self.context.ok():                    # after SIGINT the context is already shut down
-            self.robot.set_command(0.0, 0.0)
+        self.robot.set_command(0.0, 0.0)
         if self._log_file:
             self._log_file.close()
 

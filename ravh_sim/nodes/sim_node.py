@@ -38,6 +38,7 @@ from std_srvs.srv import Trigger
 from tf2_msgs.msg import TFMessage
 
 from ravh_msgs_py import names as n
+from ravh_msgs_py.query import MAX_REQUEST_CHARS
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nodes import convert
@@ -47,6 +48,7 @@ from ravh_sim.nodes.common import (
     LATCHED_QOS,
     SENSOR_QOS,
     STATE_QOS,
+    return_freed_memory,
     run_node,
 )
 from ravh_sim.render.backend import BACKENDS
@@ -370,11 +372,13 @@ class SimNode(Node):
     def _on_query(self, request: AddDiagnostics.Request, response: AddDiagnostics.Response):
         reply = self.runtime.query(request.load_namespace)
         response.success, response.message = bool(reply["ok"]), json.dumps(reply)
+        _forget_if_oversized(request)
         return response
 
     def _on_appearance(self, request: AddDiagnostics.Request, response: AddDiagnostics.Response):
         reply = self.runtime.change_appearance(request.load_namespace)
         response.success, response.message = bool(reply["ok"]), json.dumps(reply)
+        _forget_if_oversized(request)
         if reply["ok"]:
             self._publish_footprint()            # /map follows on the next step if doors changed
         return response
@@ -423,6 +427,13 @@ class SimNode(Node):
 
     def close(self) -> None:
         self.runtime.close()
+
+
+def _forget_if_oversized(request: AddDiagnostics.Request) -> None:
+    """After an oversized request (refused by its length) drop its text and return the memory it took."""
+    if len(request.load_namespace) > MAX_REQUEST_CHARS:
+        request.load_namespace = ""
+        return_freed_memory()
 
 
 def _tf_key(tf: TransformStamped) -> tuple:

@@ -52,8 +52,7 @@ class TeleopNode(Node):
 
     def close(self) -> None:
         termios.tcsetattr(sys.stdin, termios.TCSADRAIN, self._saved)
-        if self.context.ok():
-            self.pub.publish(Twist())
+        self.pub.publish(Twist())
         print()
 
 
