@@ -186,7 +186,7 @@ def test_ctrl_c_ends_a_raid_with_its_summary(tmp_path):
             time.sleep(0.5)
         assert len(_rows(out / "captures.jsonl")) >= 3 and raid.poll() is None, _log_tails(out)
         os.killpg(raid.pid, signal.SIGINT)
-        time.sleep(1.0)                                   # the second press lands while the raid winds down
+        time.sleep(0.3)                                   # the second press lands while the raid winds down
         if raid.poll() is None:
             os.killpg(raid.pid, signal.SIGINT)
         stdout, stderr = raid.communicate(timeout=120)

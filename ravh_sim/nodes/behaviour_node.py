@@ -129,6 +129,7 @@ class BehaviourNode(Node):
         self._pending: set[Future] = set()
         self.wait_recorder, self.lockstep = wait_recorder, lockstep
         self._unrecorded: dict[float, tuple[dict[str, Any], float]] = {}   # stamp -> (event, wall deadline)
+        self._recorded_early: set[float] = set()     # confirmed before the capture's reply was handled
         if wait_recorder:
             self.create_subscription(String, n.agent_name(n.CAPTURE_RECORDED, agent, first), self._on_recorded,
                                      HANDOVER_QOS)
@@ -235,16 +236,19 @@ class BehaviourNode(Node):
         else:
             event = json.loads(result.message)
             event["reason"] = reason
-            if self.wait_recorder:
+            if self.wait_recorder and event["stamp"] not in self._recorded_early:
                 self._unrecorded[event["stamp"]] = (event, time.monotonic() + RECORD_TIMEOUT_S)
             else:
+                self._recorded_early.discard(event["stamp"])
                 self._record(event)
         self._finish_when_answered()
         self._grant_when_ready()
 
     def _on_recorded(self, msg: String) -> None:
         stamp = json.loads(msg.data)["stamp"]
-        if stamp in self._unrecorded:
+        if stamp not in self._unrecorded:           # the recorder can be quicker than the capture's reply
+            self._recorded_early.add(stamp)
+        else:
             self._record(self._unrecorded.pop(stamp)[0])
             self._finish_when_answered()
             self._grant_when_ready()
