@@ -44,7 +44,7 @@ from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.planner import Path as PlannedPath
 from ravh_sim.nav.planner import plan_path
 from ravh_sim.nodes import convert
-from ravh_sim.nodes.common import COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, STATE_QOS, SimWatchdog
+from ravh_sim.nodes.common import COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, RECORDED_QOS, STATE_QOS, SimWatchdog
 from ravh_sim.poses import Pose2D, yaw_from_quaternion
 from ravh_sim.robot.profile import load_profile
 
@@ -132,7 +132,7 @@ class BehaviourNode(Node):
         self._recorded_early: set[float] = set()     # confirmed before the capture's reply was handled
         if wait_recorder:
             self.create_subscription(String, n.agent_name(n.CAPTURE_RECORDED, agent, first), self._on_recorded,
-                                     HANDOVER_QOS)
+                                     RECORDED_QOS)
         self._log_file = open(log_path, "a") if log_path else None
         SimWatchdog(self)
         self.create_timer(1.0, self._check_recorder, clock=Clock(clock_type=ClockType.STEADY_TIME))

@@ -56,7 +56,7 @@ from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nodes import convert
-from ravh_sim.nodes.common import HANDOVER_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, SimWatchdog, run_node
+from ravh_sim.nodes.common import LATCHED_QOS, RECORDED_QOS, SENSOR_QOS, STATE_QOS, SimWatchdog, run_node
 
 NS = 1_000_000_000
 PENDING_TIMEOUT_S = 30.0      # wall seconds a stamp's parts wait for the rest of their capture
@@ -264,7 +264,7 @@ class RecorderNode(Node):
             raise UserError(f"unknown agent {agent!r}; the sim has {', '.join(agents)}")
         self.agent = agent
         self.recorded_pub = self.create_publisher(String, n.agent_name(n.CAPTURE_RECORDED, agent, agent == agents[0]),
-                                                  HANDOVER_QOS)
+                                                  RECORDED_QOS)
         self._submit(self.writer.write_meta, footprint["house"], [agent], self.raid, self.bag is not None)
         for key, part in self.parts.items():
             name = n.agent_name(part.base, agent, agent == agents[0])
