@@ -200,3 +200,29 @@ def test_ctrl_c_ends_a_raid_with_its_summary(tmp_path):
     assert printed == saved and saved["status"] == "interrupted (Ctrl-C)", (saved, _log_tails(out))
     assert "Traceback" not in stderr + _log_tails(out), stderr[-3000:] + _log_tails(out)
     assert saved["captures"] == saved["requested"] == len(_consistent(out)) >= 3
+
+
+# Runs a command with writes past N bytes per file failing (EFBIG), as on a full disk; its children inherit it.
+FILE_SIZE_LIMITED = ("import os, resource, sys\n"
+                     "resource.setrlimit(resource.RLIMIT_FSIZE, (int(sys.argv[1]), resource.getrlimit("
+                     "resource.RLIMIT_FSIZE)[1]))\n"
+                     "os.execv(sys.executable, [sys.executable, *sys.argv[2:]])\n")
+
+
+def test_a_full_disk_ends_a_raid_with_one_line_and_its_summary(tmp_path):
+    """Images and the bag do not fit (200 kB per file), small files do: the recorder ends with one line,
+    the raid says which process stopped, and nothing half-written or temporary is left in the dataset."""
+    out = tmp_path / "raid"
+    raid = subprocess.run([sys.executable, "-c", FILE_SIZE_LIMITED, "200000", "-m", "ravh_sim.cli", "raid",
+                           "--house", "20", "--raid", "1", "--fast", "--out", str(out)],
+                          env=ros_env(), capture_output=True, text=True, timeout=300)
+    assert raid.returncode == 1, raid.stderr[-3000:] + _log_tails(out)
+    saved = json.loads((out / "raid.json").read_text())
+    assert json.loads(raid.stdout) == saved
+    assert saved["status"] == "the recorder stopped with exit status 2 (see logs/recorder.log)", _log_tails(out)
+    log = (out / "logs" / "recorder.log").read_text()
+    assert "Traceback" not in log and log.rstrip().splitlines()[-1] == "ravh: error: File too large", log[-3000:]
+    dataset_files = [p for p in out.rglob("*") if p.is_file() and "logs" not in p.parts and "bag" not in p.parts]
+    assert [p.name for p in dataset_files if p.name.startswith(".")] == []
+    assert [p.name for p in dataset_files if p.stat().st_size == 0] in ([], ["captures.jsonl"])
+    assert len(Dataset(out)) == saved["captures"]

@@ -116,8 +116,11 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
                     rooms = {r.get("room") for r in rows if r.get("room")}
                     print(f"\r[house {house} raid {raid}] {len(rows)} captures, {len(rooms)} rooms, "
                           f"{time.monotonic() - start:.0f} s", end="", file=sys.stderr, flush=True)
-                if sim.poll() is not None or recorder.poll() is not None:
-                    status = "a process died (see logs/)"
+                stopped = [(name, proc) for name, proc in (("sim", sim), ("recorder", recorder))
+                           if proc.poll() is not None]
+                if stopped:
+                    name, proc = stopped[0]
+                    status = f"the {name} stopped with exit status {proc.returncode} (see logs/{name}.log)"
                     break
                 if max_captures and len(rows) >= max_captures:
                     status = f"stopped at {max_captures} captures"

@@ -143,8 +143,9 @@ def spin_until_stopped(node, stop: StopSignals) -> None:
 
 
 def run_node(make_node: Callable[[list[str]], object], argv: list[str] | None = None) -> int:
-    """rclpy.init, build the node, spin until SIGINT/SIGTERM, shut down cleanly. User errors print one
-    line. Returns 2 after a user error, else the node's ``exit_code`` after close (0 unless it failed)."""
+    """rclpy.init, build the node, spin until SIGINT/SIGTERM, shut down cleanly. User errors and write
+    errors (a full disk, also while closing) print one line and return 2; else the node's ``exit_code``
+    after close (0 unless it failed)."""
     import rclpy
     from rclpy.signals import SignalHandlerOptions
 
@@ -155,12 +156,12 @@ def run_node(make_node: Callable[[list[str]], object], argv: list[str] | None = 
     stop = StopSignals()
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     node = None
+    failed = False
     try:
         node = make_node(rclpy.utilities.remove_ros_args(args)[1:])
         spin_until_stopped(node, stop)
-    except UserError as e:
-        print(f"ravh: error: {e}", file=sys.stderr)
-        return 2
+    except (UserError, OSError) as e:
+        failed = _print_error(e)
     except KeyboardInterrupt:
         pass
     except RuntimeError:
@@ -170,9 +171,21 @@ def run_node(make_node: Callable[[list[str]], object], argv: list[str] | None = 
         stop.interrupting = False           # a second Ctrl-C must not cut close() short
         if node is not None:
             close = getattr(node, "close", None)
-            if close:
-                close()
+            try:
+                if close:
+                    close()
+            except OSError as e:
+                failed = failed or _print_error(e)      # the same full disk again: said already
             node.destroy_node()
         rclpy.try_shutdown()
         stop.restore()
-    return getattr(node, "exit_code", 0)
+    return 2 if failed else getattr(node, "exit_code", 0)
+
+
+def _print_error(e: Exception) -> bool:
+    """One line on stderr for a user error or an OSError (naming the file when known)."""
+    if isinstance(e, OSError):
+        print(f"ravh: error: {f'{e.filename}: ' if e.filename else ''}{e.strerror or e}", file=sys.stderr)
+    else:
+        print(f"ravh: error: {e}", file=sys.stderr)
+    return True
