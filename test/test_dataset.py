@@ -2,12 +2,14 @@
 recorder node against a real sim (captures, the MCAP bag, SIGKILL in the middle of a raid)."""
 from __future__ import annotations
 
+import errno
 import json
 import math
 import os
 import signal
 import time
 from collections import Counter
+from dataclasses import replace
 from pathlib import Path
 
 import cv2
@@ -15,6 +17,7 @@ import numpy as np
 import pytest
 from conftest import resolved
 from rosgraph import NodeProcess, remove_orphan_shm, spin_until, start_rclpy
+from test_files import file_size_limit
 
 from ravh_msgs_py import names as n
 from ravh_msgs_py.capture import CaptureEvent
@@ -175,6 +178,36 @@ def test_torn_lines_and_missing_files_are_skipped(tmp_path, footprint20):
     (root / "rgb/000000.png").unlink()                         # a file lost in a power cut
     ds = Dataset(root)
     assert [s.index for s in ds] == [1]
+
+
+def test_a_full_disk_stops_a_capture_without_a_torn_file(tmp_path, footprint20):
+    """Writes past a file-size limit fail as on a full disk: the capture that did not fit raises, and the
+    dataset keeps the captures before it, with no torn line, no empty file and no temp file."""
+    room = sorted(rooms_of(footprint20))[0]
+    root = tmp_path / "full"
+    blank = {**capture(np.random.default_rng(0), []), "rgb": np.zeros((H, W, 3), np.uint8),
+             "depth": np.ones((H, W), np.float32), "instance": np.zeros((H, W), np.uint16)}
+    blank["scan"] = replace(blank["scan"], ranges=np.ones(8, np.float32))
+    writer = DatasetWriter(root)
+    writer.write_footprint(footprint20)
+    writer.write_meta(20, ["robot"])
+    line = 0
+    with file_size_limit(1500), pytest.raises(OSError) as full:     # captures.jsonl fills up first
+        for k in range(100):
+            line = (root / layout.CAPTURES_JSONL).stat().st_size
+            writer.write_capture(event(float(k), room), blank)
+    assert full.value.errno == errno.EFBIG and 0 < writer.count < 100
+    assert (root / layout.CAPTURES_JSONL).stat().st_size == line        # the part-written line was cut off
+    with file_size_limit(2000), pytest.raises(OSError):                 # an image does not fit
+        writer.write_capture(event(99.0, room), capture(np.random.default_rng(0), []))
+    writer.close()
+    everything = [p for p in root.rglob("*") if p.is_file()]
+    assert [p for p in everything if p.name.startswith(layout.TMP_PREFIX) or p.stat().st_size == 0] == []
+    lines = (root / layout.CAPTURES_JSONL).read_text().splitlines(keepends=True)
+    assert len(lines) == writer.count and all(ln.endswith("\n") and json.loads(ln) for ln in lines)
+    ds = Dataset(root)
+    assert [s.stamp for s in ds] == [float(k) for k in range(writer.count)]
+    assert ds[0].rgb.shape == (H, W, 3)
 
 
 def test_depth_encoding_limits():

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import signal
 import subprocess
 import sys
 import time
@@ -13,7 +15,7 @@ import pytest
 from rosgraph import NodeProcess, ros_env
 
 from ravh_sim.dataset.api import Dataset
-from ravh_sim.dataset.raid import PRESETS, _final_status, preset_settings, run_raid
+from ravh_sim.dataset.raid import PRESETS, _final_status, _rows, preset_settings, run_raid
 from ravh_sim.errors import UserError
 from ravh_sim.nodes.common import SIM_LOST_S
 
@@ -117,6 +119,7 @@ class _Exited:
     ("done", 30, 30, 2, 0, "behaviour exited with 2 (see logs/behaviour.log)"),
     ("done", 30, 30, 0, 1, "recorder exited with 1 (see logs/recorder.log)"),
     ("interrupted (Ctrl-C)", 3, 3, 0, 0, "interrupted (Ctrl-C)"),
+    ("interrupted (Ctrl-C)", 3, 2, 0, 0, "interrupted (Ctrl-C); lost 1 of 3 captures (see logs/)"),
 ])
 def test_a_raid_is_done_only_when_nothing_was_lost(status, requested, recorded, behaviour, recorder, expected):
     assert _final_status(status, requested, recorded, _Exited(behaviour), _Exited(recorder)) == expected
@@ -160,3 +163,66 @@ def test_same_seed_same_raid(tmp_path, raid_env):
     for a, b in zip(rows[0], rows[1]):
         for kind in ("rgb", "depth", "mask", "scan"):
             assert (outs[0] / a["files"][kind]).read_bytes() == (outs[1] / b["files"][kind]).read_bytes(), kind
+
+
+def _group_alive(pgid: int) -> bool:
+    try:
+        os.killpg(pgid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+def test_ctrl_c_ends_a_raid_with_its_summary(tmp_path):
+    """Ctrl-C in a terminal reaches the raid and its processes (one process group), pressed twice here:
+    the raid still stops every process, prints its summary, writes raid.json and leaves a readable dataset."""
+    out = tmp_path / "raid"
+    raid = subprocess.Popen([sys.executable, "-m", "ravh_sim.cli", "raid", "--house", "20", "--raid", "1", "--fast",
+                             "--out", str(out)], env=ros_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)
+    try:
+        end = time.monotonic() + 300
+        while len(_rows(out / "captures.jsonl")) < 3 and raid.poll() is None and time.monotonic() < end:
+            time.sleep(0.5)
+        assert len(_rows(out / "captures.jsonl")) >= 3 and raid.poll() is None, _log_tails(out)
+        os.killpg(raid.pid, signal.SIGINT)
+        time.sleep(0.3)                                   # the second press lands while the raid winds down
+        if raid.poll() is None:
+            os.killpg(raid.pid, signal.SIGINT)
+        stdout, stderr = raid.communicate(timeout=120)
+    finally:
+        if _group_alive(raid.pid):
+            os.killpg(raid.pid, signal.SIGKILL)
+    assert raid.returncode == 1, stderr[-3000:] + _log_tails(out)
+    assert not _group_alive(raid.pid), "a raid process outlived the raid"
+    printed = json.loads(stdout)
+    saved = json.loads((out / "raid.json").read_text())
+    assert printed == saved and saved["status"] == "interrupted (Ctrl-C)", (saved, _log_tails(out))
+    assert "Traceback" not in stderr + _log_tails(out), stderr[-3000:] + _log_tails(out)
+    assert saved["captures"] == saved["requested"] == len(_consistent(out)) >= 3
+
+
+# Runs a command with writes past N bytes per file failing (EFBIG), as on a full disk; its children inherit it.
+FILE_SIZE_LIMITED = ("import os, resource, sys\n"
+                     "resource.setrlimit(resource.RLIMIT_FSIZE, (int(sys.argv[1]), resource.getrlimit("
+                     "resource.RLIMIT_FSIZE)[1]))\n"
+                     "os.execv(sys.executable, [sys.executable, *sys.argv[2:]])\n")
+
+
+def test_a_full_disk_ends_a_raid_with_one_line_and_its_summary(tmp_path):
+    """Images and the bag do not fit (200 kB per file), small files do: the recorder ends with one line,
+    the raid says which process stopped, and nothing half-written or temporary is left in the dataset."""
+    out = tmp_path / "raid"
+    raid = subprocess.run([sys.executable, "-c", FILE_SIZE_LIMITED, "200000", "-m", "ravh_sim.cli", "raid",
+                           "--house", "20", "--raid", "1", "--fast", "--out", str(out)],
+                          env=ros_env(), capture_output=True, text=True, timeout=300)
+    assert raid.returncode == 1, raid.stderr[-3000:] + _log_tails(out)
+    saved = json.loads((out / "raid.json").read_text())
+    assert json.loads(raid.stdout) == saved
+    assert saved["status"] == "the recorder stopped with exit status 2 (see logs/recorder.log)", _log_tails(out)
+    log = (out / "logs" / "recorder.log").read_text()
+    assert "Traceback" not in log and log.rstrip().splitlines()[-1] == "ravh: error: File too large", log[-3000:]
+    dataset_files = [p for p in out.rglob("*") if p.is_file() and "logs" not in p.parts and "bag" not in p.parts]
+    assert [p.name for p in dataset_files if p.name.startswith(".")] == []
+    assert [p.name for p in dataset_files if p.stat().st_size == 0] in ([], ["captures.jsonl"])
+    assert len(Dataset(out)) == saved["captures"]

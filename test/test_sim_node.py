@@ -261,3 +261,27 @@ def test_bad_velocities_are_refused_with_a_warning(sim):
     probe.spin(1.0)
     assert proc.alive()
     assert "rejected" in proc.log()
+
+
+def test_oversized_requests_are_refused_and_not_kept(sim):
+    """10 MB requests are refused by their length; the sim keeps no copy of them (its memory after six
+    is what it was after two), and what stays is bounded (DDS buffers, not requests)."""
+    proc, probe = sim
+
+    def rss_mb() -> float:
+        with open(f"/proc/{proc.proc.pid}/status") as f:
+            return next(int(line.split()[1]) for line in f if line.startswith("VmRSS:")) / 1024
+
+    big = "x" * 10_000_000
+    before = rss_mb()
+    replies, after_two = [], 0.0
+    for k in range(6):
+        service = n.QUERY_SERVICE if k % 2 == 0 else n.APPEARANCE_SERVICE
+        replies.append(probe.call(AddDiagnostics, service, AddDiagnostics.Request(load_namespace=big), timeout=60))
+        if k == 1:
+            after_two = rss_mb()
+    after_six = rss_mb()
+    assert all(not r.success and "over the limit" in r.message and len(r.message) < 1000 for r in replies)
+    assert after_six - after_two < 5, (before, after_two, after_six)
+    assert after_six - before < 40, (before, after_two, after_six)
+    assert proc.alive()

@@ -21,8 +21,9 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,6 +38,7 @@ FAST_RTF = 4.0                   # --fast: sim seconds per wall second asked of 
 POLL_S = 0.5
 RECORDER_START_S = 120.0         # the recorder is ready once the sim's footprint reached it
 DISCOVERY_S = 2.0
+INTERRUPTED = "interrupted (Ctrl-C)"
 HANDOVER_GRACE_S = 30.0          # wall seconds the recorder gets to store the behaviour's last captures
 
 
@@ -95,50 +97,56 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
     captures, given = out / layout.CAPTURES_JSONL, logs / "behaviour_captures.jsonl"
     status = "done"
     sim = recorder = behaviour = None
-    try:
-        sim = _spawn(["sim", "--house", str(house), "--config", str(settings_path), "--rtf", str(rtf),
-                      "--camera-rate", "0", "--lockstep"], env, logs / "sim.log")
-        recorder = _spawn(["recorder", "--out", str(out), "--raid", json.dumps(raid_meta)], env,
-                          logs / "recorder.log")
-        _wait_for(lambda: (out / layout.DATASET_JSON).exists() or sim.poll() is not None
-                  or recorder.poll() is not None, RECORDER_START_S)
-        time.sleep(DISCOVERY_S)                  # let the recorder's capture subscriptions match
-        behaviour = _spawn([preset.behaviour, "--log", str(given), "--wait-recorder", "--lockstep",
-                            *behaviour_args],
-                           env, logs / "behaviour.log")
-        while behaviour.poll() is None:
-            rows = _rows(captures)
-            if not quiet:
-                rooms = {r.get("room") for r in rows if r.get("room")}
-                print(f"\r[house {house} raid {raid}] {len(rows)} captures, {len(rooms)} rooms, "
-                      f"{time.monotonic() - start:.0f} s", end="", file=sys.stderr, flush=True)
-            if sim.poll() is not None or recorder.poll() is not None:
-                status = "a process died (see logs/)"
-                break
-            if max_captures and len(rows) >= max_captures:
-                status = f"stopped at {max_captures} captures"
-                break
-            if time.monotonic() - start > timeout:
-                status = f"timed out after {timeout:.0f} s"
-                break
-            time.sleep(POLL_S)
-    except KeyboardInterrupt:
-        status = "interrupted (Ctrl-C)"
-    finally:
-        _stop(behaviour)
-        if recorder is not None:
-            _wait_for(lambda: len(_rows(captures)) >= len(_rows(given)) or recorder.poll() is not None,
-                      HANDOVER_GRACE_S)
-        _stop(recorder)
-        _stop(sim)
-    rows, requested = _rows(captures), len(_rows(given))
-    status = _final_status(status, requested, len(rows), behaviour, recorder)
-    summary = {**raid_meta, "status": status, "captures": len(rows), "requested": requested,
-               "rooms_visited": sorted({r["room"] for r in rows if r.get("room")}),
-               "wall_s": round(time.monotonic() - start, 1),
-               "sim_s": round(rows[-1]["stamp"] - rows[0]["stamp"], 1) if len(rows) > 1 else 0.0}
-    with _writing(out, f"; the raid ended: {status}"):
-        layout.atomic_write(out / "raid.json", (json.dumps(summary, indent=1) + "\n").encode())
+    wind_down = ExitStack()
+    with wind_down:
+        try:
+            sim = _spawn(["sim", "--house", str(house), "--config", str(settings_path), "--rtf", str(rtf),
+                          "--camera-rate", "0", "--lockstep"], env, logs / "sim.log")
+            recorder = _spawn(["recorder", "--out", str(out), "--raid", json.dumps(raid_meta)], env,
+                              logs / "recorder.log")
+            _wait_for(lambda: (out / layout.DATASET_JSON).exists() or sim.poll() is not None
+                      or recorder.poll() is not None, RECORDER_START_S)
+            time.sleep(DISCOVERY_S)                  # let the recorder's capture subscriptions match
+            behaviour = _spawn([preset.behaviour, "--log", str(given), "--wait-recorder", "--lockstep",
+                                *behaviour_args],
+                               env, logs / "behaviour.log")
+            while behaviour.poll() is None:
+                rows = _rows(captures)
+                if not quiet:
+                    rooms = {r.get("room") for r in rows if r.get("room")}
+                    print(f"\r[house {house} raid {raid}] {len(rows)} captures, {len(rooms)} rooms, "
+                          f"{time.monotonic() - start:.0f} s", end="", file=sys.stderr, flush=True)
+                stopped = [(name, proc) for name, proc in (("sim", sim), ("recorder", recorder))
+                           if proc.poll() is not None]
+                if stopped:
+                    name, proc = stopped[0]
+                    status = f"the {name} stopped with exit status {proc.returncode} (see logs/{name}.log)"
+                    break
+                if max_captures and len(rows) >= max_captures:
+                    status = f"stopped at {max_captures} captures"
+                    break
+                if time.monotonic() - start > timeout:
+                    status = f"timed out after {timeout:.0f} s"
+                    break
+                time.sleep(POLL_S)
+        except KeyboardInterrupt:
+            status = INTERRUPTED
+        finally:
+            wind_down.enter_context(_ctrl_c_ignored())       # a second Ctrl-C must not lose raid.json
+            _stop(behaviour)
+            if recorder is not None:
+                _wait_for(lambda: len(_rows(captures)) >= len(_rows(given)) or recorder.poll() is not None,
+                          HANDOVER_GRACE_S)
+            _stop(recorder)
+            _stop(sim)
+        rows, requested = _rows(captures), len(_rows(given))
+        status = _final_status(status, requested, len(rows), behaviour, recorder)
+        summary = {**raid_meta, "status": status, "captures": len(rows), "requested": requested,
+                   "rooms_visited": sorted({r["room"] for r in rows if r.get("room")}),
+                   "wall_s": round(time.monotonic() - start, 1),
+                   "sim_s": round(rows[-1]["stamp"] - rows[0]["stamp"], 1) if len(rows) > 1 else 0.0}
+        with _writing(out, f"; the raid ended: {status}"):
+            layout.atomic_write(out / "raid.json", (json.dumps(summary, indent=1) + "\n").encode())
     if not quiet:
         print(file=sys.stderr)
     return summary
@@ -148,12 +156,27 @@ def _final_status(status: str, requested: int, recorded: int, behaviour: subproc
                   recorder: subprocess.Popen | None) -> str:
     """What the raid amounts to: losses first, then a process that failed, then how it ended."""
     if recorded < requested:
-        return f"lost {requested - recorded} of {requested} captures (see logs/)"
+        lost = f"lost {requested - recorded} of {requested} captures (see logs/)"
+        return f"{status}; {lost}" if status == INTERRUPTED else lost
     if status == "done":
         for name, proc in (("behaviour", behaviour), ("recorder", recorder)):
             if proc is not None and proc.returncode not in (0, None):
                 return f"{name} exited with {proc.returncode} (see logs/{name}.log)"
     return status
+
+
+@contextmanager
+def _ctrl_c_ignored():
+    """Ignore SIGINT while a raid winds down (stopping its processes, writing raid.json): a second Ctrl-C
+    would otherwise lose the summary. The processes, in the terminal's process group, still get it."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 @contextmanager

@@ -36,7 +36,7 @@ class DatasetWriter:
             if (self.dir / layout.DATASET_JSON).exists():
                 raise UserError(f"{self.dir} already holds a dataset; record into a new folder")
             try:
-                self._rows = open(self.dir / layout.CAPTURES_JSONL, "x", encoding="utf-8")
+                self._rows = open(self.dir / layout.CAPTURES_JSONL, "xb", buffering=0)
             except FileExistsError:
                 raise UserError(f"{self.dir} already holds {layout.CAPTURES_JSONL}; record into a new folder") from None
             for kind in capture_files(0):
@@ -105,11 +105,23 @@ class DatasetWriter:
                 if facts.get(event.agent) != fact:
                     facts[event.agent] = fact
                     layout.atomic_write(self.dir / name, (json.dumps(facts, indent=1) + "\n").encode())
-        self._rows.write(json.dumps(row) + "\n")
-        self._rows.flush()
-        os.fsync(self._rows.fileno())
+        self._append_row((json.dumps(row) + "\n").encode())
         self.count += 1
         return index
+
+    def _append_row(self, line: bytes) -> None:
+        """Append one line to captures.jsonl and fsync it; a write that fails part-way (a full disk)
+        is cut off again, so the file never holds a torn line that a later line would follow."""
+        start = self._rows.tell()
+        try:
+            done = 0
+            while done < len(line):
+                done += self._rows.write(line[done:])
+            os.fsync(self._rows.fileno())
+        except OSError:
+            os.ftruncate(self._rows.fileno(), start)
+            self._rows.seek(start)
+            raise
 
     def close(self) -> None:
         self._rows.close()

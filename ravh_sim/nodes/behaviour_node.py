@@ -47,7 +47,7 @@ from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.planner import Path as PlannedPath
 from ravh_sim.nav.planner import plan_path
 from ravh_sim.nodes import convert
-from ravh_sim.nodes.common import COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, STATE_QOS, SimWatchdog, quiet_after_shutdown
+from ravh_sim.nodes.common import COMMAND_QOS, HANDOVER_QOS, LATCHED_QOS, RECORDED_QOS, STATE_QOS, SimWatchdog
 from ravh_sim.poses import Pose2D
 from ravh_sim.robot.profile import load_profile
 
@@ -156,9 +156,10 @@ class BehaviourNode(Node):
         self._pending: set[Future] = set()
         self.wait_recorder, self.lockstep = wait_recorder, lockstep
         self._unrecorded: dict[float, tuple[CaptureEvent, float]] = {}   # stamp -> (event, wall deadline)
+        self._recorded_early: set[float] = set()     # confirmed before the capture's reply was handled
         if wait_recorder:
             self.create_subscription(String, n.agent_name(n.CAPTURE_RECORDED, agent, first), self._on_recorded,
-                                     HANDOVER_QOS)
+                                     RECORDED_QOS)
         self._log_file = open(log_path, "a") if log_path else None
         SimWatchdog(self)
         self.create_timer(1.0, self._check_recorder, clock=Clock(clock_type=ClockType.STEADY_TIME))
@@ -189,7 +190,6 @@ class BehaviourNode(Node):
         raise UserError(f"no sim node answered within {STARTUP_TIMEOUT_S:.0f} s "
                         f"(is `ravh sim` running on ROS_DOMAIN_ID {os.environ.get('ROS_DOMAIN_ID', '0')}?)")
 
-    @quiet_after_shutdown
     def _tick(self) -> None:
         """Sim-time timer (not lockstep): one control step, unless holding for the recorder."""
         now = self.get_clock().now().nanoseconds * 1e-9
@@ -262,9 +262,10 @@ class BehaviourNode(Node):
             self.get_logger().warning(problem)
         else:
             event = replace(CaptureEvent.from_json(result.message), reason=reason)
-            if self.wait_recorder:
+            if self.wait_recorder and event.stamp not in self._recorded_early:
                 self._unrecorded[event.stamp] = (event, time.monotonic() + RECORD_TIMEOUT_S)
             else:
+                self._recorded_early.discard(event.stamp)
                 self._record(event)
         self._finish_when_answered()
         self._grant_when_ready()
@@ -275,7 +276,9 @@ class BehaviourNode(Node):
         except CaptureFormatError as e:
             self.get_logger().error(f"ignored a capture confirmation: {e}")
             return
-        if stamp in self._unrecorded:
+        if stamp not in self._unrecorded:           # the recorder can be quicker than the capture's reply
+            self._recorded_early.add(stamp)
+        else:
             self._record(self._unrecorded.pop(stamp)[0])
             self._finish_when_answered()
             self._grant_when_ready()
@@ -292,8 +295,7 @@ class BehaviourNode(Node):
             self._log_file.flush()
 
     def close(self) -> None:
-        if self.context.ok():                    # after SIGINT the context is already shut down
-            self.robot.set_command(0.0, 0.0)
+        self.robot.set_command(0.0, 0.0)
         if self._log_file:
             self._log_file.close()
 

@@ -2,12 +2,14 @@
 
 QoS follows the guide's rules: sensors are RELIABLE (a recorder must not lose frames; best-effort
 subscribers still match), maps and other once-published facts are RELIABLE + TRANSIENT_LOCAL so late
-subscribers get them. Nodes stop on SIGINT (Fast DDS leaves shared-memory files behind on SIGKILL).
+subscribers get them. Nodes stop cleanly on SIGINT and SIGTERM (Fast DDS leaves shared-memory files
+behind on SIGKILL).
 """
 from __future__ import annotations
 
-import functools
+import ctypes
 import os
+import signal
 import sys
 import time
 from collections.abc import Callable
@@ -17,6 +19,7 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from ravh_sim.paths import FASTDDS_PROFILE
 
 SIM_LOST_S = 8.0        # wall seconds without /clock after which a sim counts as gone
+STOP_LATENCY_S = 0.1    # longest a spinning node takes to notice SIGINT/SIGTERM
 
 SENSOR_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=5, reliability=ReliabilityPolicy.RELIABLE,
                         durability=DurabilityPolicy.VOLATILE)
@@ -27,6 +30,10 @@ LATCHED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1, reliability=R
 # capture hand-over acknowledgements: none may be lost, and there are few of them
 HANDOVER_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE,
                           durability=DurabilityPolicy.VOLATILE)
+# "capture stored" confirmations: latched, so a behaviour whose subscription the recorder's publisher
+# matched only after the first capture still gets its confirmation (a behaviour holds one at a time)
+RECORDED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100, reliability=ReliabilityPolicy.RELIABLE,
+                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
 COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.VOLATILE)
 
@@ -84,48 +91,101 @@ def use_large_message_transport() -> None:
         os.environ["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(FASTDDS_PROFILE)
 
 
-def quiet_after_shutdown(callback: Callable) -> Callable:
-    """Wrap a timer/subscription callback of a Node: once SIGINT has shut the context down, a publish
-    that was under way raises; that is the node stopping, not an error worth a traceback."""
-    @functools.wraps(callback)
-    def wrapper(self, *args, **kwargs):
-        try:
-            return callback(self, *args, **kwargs)
-        except Exception:
-            if self.context.ok():
-                raise
-    return wrapper
+def return_freed_memory() -> None:
+    """Hand freed heap pages back to the OS (glibc's malloc_trim; nothing elsewhere). glibc keeps what
+    a large request freed for reuse: measured here, each oversized service request (10 MB of JSON,
+    refused by its length) would leave the sim ~10 MB bigger for the rest of its life."""
+    try:
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+
+
+class StopSignals:
+    """SIGINT and SIGTERM as a request to stop that the spin loop checks, not an exception raised
+    wherever Python happens to be.
+
+    rclpy's own handler raises KeyboardInterrupt in the main thread (and shuts the context down from
+    another thread while callbacks still run). A KeyboardInterrupt raised while rclpy's C++ converts a
+    taken message to Python is swallowed by pybind11 and comes out as "RuntimeError: Unable to convert
+    call argument '0' to Python object": a node stopped with Ctrl-C then exits 1 with a traceback (a
+    loaded machine makes that instant likelier). While the node is being built (it may wait for the
+    sim) a signal still raises KeyboardInterrupt; once it spins, a signal only sets :attr:`requested`.
+    """
+
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+    def __init__(self) -> None:
+        self.requested = False
+        self.interrupting = True            # raise KeyboardInterrupt (only before the node spins)
+        self._previous = {sig: signal.signal(sig, self._handle) for sig in self.SIGNALS}
+
+    def _handle(self, _signum, _frame) -> None:
+        self.requested = True
+        if self.interrupting:
+            raise KeyboardInterrupt
+
+    def restore(self) -> None:
+        for sig, handler in self._previous.items():
+            signal.signal(sig, handler)
+
+
+def spin_until_stopped(node, stop: StopSignals) -> None:
+    """Spin ``node`` until a stop signal, or until its ``finished`` future (behaviours that end) is done.
+    rcl_wait does not return on a signal, so the wait is bounded by :data:`STOP_LATENCY_S`."""
+    import rclpy
+    executor = rclpy.get_global_executor()
+    executor.add_node(node)
+    finished = getattr(node, "finished", None)
+    stop.interrupting = False
+    while not stop.requested and not (finished is not None and finished.done()):
+        executor.spin_once(timeout_sec=STOP_LATENCY_S)
 
 
 def run_node(make_node: Callable[[list[str]], object], argv: list[str] | None = None) -> int:
-    """rclpy.init, build the node, spin until SIGINT, shut down cleanly. User errors print one line.
-    Returns 2 after a user error, else the node's ``exit_code`` after close (0 unless it failed)."""
+    """rclpy.init, build the node, spin until SIGINT/SIGTERM, shut down cleanly. User errors and write
+    errors (a full disk, also while closing) print one line and return 2; else the node's ``exit_code``
+    after close (0 unless it failed)."""
     import rclpy
-    from rclpy.executors import ExternalShutdownException
+    from rclpy.signals import SignalHandlerOptions
 
     from ravh_sim.errors import UserError
 
     use_large_message_transport()
     args = sys.argv if argv is None else argv
-    rclpy.init(args=args)
+    stop = StopSignals()
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     node = None
+    failed = False
     try:
         node = make_node(rclpy.utilities.remove_ros_args(args)[1:])
-        finished = getattr(node, "finished", None)        # behaviours that end complete this future
-        if finished is not None:
-            rclpy.spin_until_future_complete(node, finished)
-        else:
-            rclpy.spin(node)
-    except UserError as e:
-        print(f"ravh: error: {e}", file=sys.stderr)
-        return 2
-    except (KeyboardInterrupt, ExternalShutdownException):
+        spin_until_stopped(node, stop)
+    except (UserError, OSError) as e:
+        failed = _print_error(e)
+    except KeyboardInterrupt:
         pass
+    except RuntimeError:
+        if not stop.requested:              # else a KeyboardInterrupt that rclpy's C++ turned into this
+            raise
     finally:
+        stop.interrupting = False           # a second Ctrl-C must not cut close() short
         if node is not None:
             close = getattr(node, "close", None)
-            if close:
-                close()
+            try:
+                if close:
+                    close()
+            except OSError as e:
+                failed = failed or _print_error(e)      # the same full disk again: said already
             node.destroy_node()
         rclpy.try_shutdown()
-    return getattr(node, "exit_code", 0)
+        stop.restore()
+    return 2 if failed else getattr(node, "exit_code", 0)
+
+
+def _print_error(e: Exception) -> bool:
+    """One line on stderr for a user error or an OSError (naming the file when known)."""
+    if isinstance(e, OSError):
+        print(f"ravh: error: {f'{e.filename}: ' if e.filename else ''}{e.strerror or e}", file=sys.stderr)
+    else:
+        print(f"ravh: error: {e}", file=sys.stderr)
+    return True

@@ -56,7 +56,7 @@ from ravh_sim.dataset import layout
 from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nodes import convert
-from ravh_sim.nodes.common import HANDOVER_QOS, LATCHED_QOS, SENSOR_QOS, STATE_QOS, SimWatchdog, run_node
+from ravh_sim.nodes.common import LATCHED_QOS, RECORDED_QOS, SENSOR_QOS, STATE_QOS, SimWatchdog, run_node
 from ravh_sim.sensors.suite import SENSORS
 
 NS = 1_000_000_000
@@ -241,7 +241,7 @@ class RecorderNode(Node):
             raise UserError(f"unknown agent {agent!r}; the sim has {', '.join(agents)}")
         self.agent = agent
         self.recorded_pub = self.create_publisher(String, n.agent_name(n.CAPTURE_RECORDED, agent, agent == agents[0]),
-                                                  HANDOVER_QOS)
+                                                  RECORDED_QOS)
         self._submit(self.writer.write_meta, footprint["house"], [agent], self.raid, self.bag is not None)
         for key, part in self.parts.items():
             name = n.agent_name(part.base, agent, agent == agents[0])
@@ -315,13 +315,9 @@ class RecorderNode(Node):
         self.log.info(f"capture {index} at t={event.stamp:.2f} s in {event.room}")
 
     def _confirm(self, stamp: float, index: int) -> None:
-        """Tell the behaviour its capture is stored (not possible any more once SIGINT shut ROS down)."""
+        """Tell the behaviour its capture is stored (close() runs before ROS shuts down, so this always can)."""
         assert self.recorded_pub is not None, "captures are matched only once the agent is known"
-        try:
-            self.recorded_pub.publish(String(data=CaptureRecorded(stamp, index).to_json()))
-        except Exception:
-            if self.context.ok():
-                raise
+        self.recorded_pub.publish(String(data=CaptureRecorded(stamp, index).to_json()))
 
     def _submit(self, fn: Callable[..., object], *args: Any) -> None:
         self.worker.submit(fn, *args).add_done_callback(self._report)
@@ -339,8 +335,6 @@ class RecorderNode(Node):
 
     def close(self) -> None:
         """Finish queued writes, then close the dataset and the bag (SIGINT lands here)."""
-        # after SIGINT the context is gone and the node's logger cannot reach /rosout: log locally
-        self.log = rclpy.logging.get_logger("ravh_recorder.close")
         waiting = sum("event" in e.parts for e in self.matcher.pending.values())
         self.worker.shutdown(wait=True)
         self.writer.close()

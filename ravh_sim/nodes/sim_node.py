@@ -40,6 +40,7 @@ from tf2_msgs.msg import TFMessage
 
 from ravh_msgs_py import names as n
 from ravh_msgs_py.capture import CaptureEvent
+from ravh_msgs_py.query import MAX_REQUEST_CHARS
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nodes import convert
@@ -49,7 +50,7 @@ from ravh_sim.nodes.common import (
     LATCHED_QOS,
     SENSOR_QOS,
     STATE_QOS,
-    quiet_after_shutdown,
+    return_freed_memory,
     run_node,
 )
 from ravh_sim.render.backend import BACKENDS
@@ -172,7 +173,6 @@ class SimNode(Node):
                 lambda req, res, a=agent: self._on_capture(a, res))
 
     # ------------------------------------------------------------------ stepping
-    @quiet_after_shutdown
     def _tick(self) -> None:
         """Advance sim time towards wall time x RTF, publishing whatever falls due on the way."""
         rt = self.runtime
@@ -363,11 +363,13 @@ class SimNode(Node):
     def _on_query(self, request: AddDiagnostics.Request, response: AddDiagnostics.Response):
         reply = self.runtime.query(request.load_namespace)
         response.success, response.message = bool(reply["ok"]), json.dumps(reply)
+        _forget_if_oversized(request)
         return response
 
     def _on_appearance(self, request: AddDiagnostics.Request, response: AddDiagnostics.Response):
         reply = self.runtime.change_appearance(request.load_namespace)
         response.success, response.message = bool(reply["ok"]), json.dumps(reply)
+        _forget_if_oversized(request)
         if reply["ok"]:
             self._publish_footprint()            # /map follows on the next step if doors changed
         return response
@@ -416,6 +418,13 @@ class SimNode(Node):
 
     def close(self) -> None:
         self.runtime.close()
+
+
+def _forget_if_oversized(request: AddDiagnostics.Request) -> None:
+    """After an oversized request (refused by its length) drop its text and return the memory it took."""
+    if len(request.load_namespace) > MAX_REQUEST_CHARS:
+        request.load_namespace = ""
+        return_freed_memory()
 
 
 def _tf_key(tf: TransformStamped) -> tuple:

@@ -16,7 +16,7 @@ from ravh_msgs_py import names as n
 from ravh_sim.behaviours.teleop import HELP, Teleop
 from ravh_sim.errors import UserError
 from ravh_sim.nodes.behaviour_node import which_agent
-from ravh_sim.nodes.common import COMMAND_QOS, quiet_after_shutdown, run_node
+from ravh_sim.nodes.common import COMMAND_QOS, run_node
 from ravh_sim.robot.profile import load_profile
 
 PUBLISH_HZ = 10.0
@@ -39,7 +39,6 @@ class TeleopNode(Node):
         print(HELP, flush=True)
         self.create_timer(1.0 / PUBLISH_HZ, self._tick)
 
-    @quiet_after_shutdown
     def _tick(self) -> None:
         while select.select([sys.stdin], [], [], 0)[0]:
             action = self.teleop.press(sys.stdin.read(1))
@@ -54,8 +53,7 @@ class TeleopNode(Node):
 
     def close(self) -> None:
         termios.tcsetattr(sys.stdin, termios.TCSADRAIN, self._saved)
-        if self.context.ok():
-            self.pub.publish(Twist())
+        self.pub.publish(Twist())
         print()
 
 
