@@ -14,6 +14,7 @@ import sys
 import time
 from collections.abc import Callable
 
+from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from ravh_sim.paths import FASTDDS_PROFILE
@@ -142,7 +143,7 @@ def spin_until_stopped(node, stop: StopSignals) -> None:
         executor.spin_once(timeout_sec=STOP_LATENCY_S)
 
 
-def run_node(make_node: Callable[[list[str]], object], argv: list[str] | None = None) -> int:
+def run_node(make_node: Callable[[list[str]], Node], argv: list[str] | None = None) -> int:
     """rclpy.init, build the node, spin until SIGINT/SIGTERM, shut down cleanly. User errors and write
     errors (a full disk, also while closing) print one line and return 2; else the node's ``exit_code``
     after close (0 unless it failed)."""
