@@ -2,11 +2,18 @@
 from __future__ import annotations
 
 import os
+import signal
 from pathlib import Path
 
 import pytest
 
 os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+
+# A suite started as a background job of a non-interactive shell (`nohup tools/test.sh &`, some CI
+# runners) inherits an ignored SIGINT, which every child would inherit too: the Ctrl-C tests would then
+# signal processes that cannot hear it. Children get Python's default handling back.
+if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 ROOT = Path(__file__).resolve().parents[1]
 UPSTREAM = ROOT.parent / "shared" / "upstream-houses"
