@@ -28,6 +28,7 @@ setup(
         (f"share/{PACKAGE}", ["package.xml"]),
         (f"lib/{PACKAGE}", sorted(str(p) for p in Path("scripts").iterdir())),
         *tree("houses"),
+        *tree("furniture"),
         *tree("config"),
     ],
     package_data={"ravh_sim.render": ["shaders/*.glsl", "shaders/*.vert", "shaders/*.frag"]},

@@ -1,4 +1,4 @@
-"""Where the package's data lives: houses, config and robot profiles.
+"""Where the package's data lives: houses, the furniture library, config and robot profiles.
 
 In a source checkout the data sits beside the package (the repository root); installed by pip or
 colcon it sits in <prefix>/share/ravh_sim, three levels above site-packages. One place decides, so
@@ -14,6 +14,7 @@ _INSTALLED = _PACKAGE.parents[3] / "share" / "ravh_sim" if len(_PACKAGE.parents)
 DATA_DIR = _CHECKOUT if (_CHECKOUT / "houses").is_dir() else _INSTALLED
 
 HOUSES_DIR = DATA_DIR / "houses"
+FURNITURE_DIR = DATA_DIR / "furniture"
 CONFIG_DIR = DATA_DIR / "config"
 ROBOTS_DIR = CONFIG_DIR / "robots"
 DEFAULT_CONFIG = CONFIG_DIR / "default.yaml"

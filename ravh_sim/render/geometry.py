@@ -2,8 +2,8 @@
 
 Every triangle corner carries its house-frame position, a shading normal, its position in the body's
 own frame (procedural patterns are evaluated there, so a wood grain moves with its table and does
-not swim when a door swings), a material index (ravh_sim.render.materials) and the instance id that
-instance images store. Normals come from trimesh: smooth across gentle bends (cushions, bowls,
+not swim when a door swings), a material index (ravh_sim.render.materials), the instance id that
+instance images store and a texture coordinate (library models' textures; zero elsewhere). Normals come from trimesh: smooth across gentle bends (cushions, bowls,
 lamp shades), flat across creases (box edges), decided per corner by a crease angle.
 """
 from __future__ import annotations
@@ -15,35 +15,51 @@ import numpy as np
 import trimesh
 
 from ravh_sim.render.materials import MaterialTable
+from ravh_sim.world.library import FittedModel
 from ravh_sim.world.mesh import Mesh
 from ravh_sim.world.scene import Visual, World
 
-FLOATS_PER_VERTEX = 11                       # position 3, normal 3, local 3, material 1, instance 1
-VERTEX_FORMAT = "3f 3f 3f 1f 1f"
-ATTRIBUTES = ("in_position", "in_normal", "in_local", "in_material", "in_instance")
+FLOATS_PER_VERTEX = 13                       # position 3, normal 3, local 3, material 1, instance 1, uv 2
+VERTEX_FORMAT = "3f 3f 3f 1f 1f 2f"
+ATTRIBUTES = ("in_position", "in_normal", "in_local", "in_material", "in_instance", "in_uv")
 CREASE_COS = math.cos(math.radians(40.0))    # corners bent less than this share a smooth normal
 
 
 @dataclass(frozen=True)
 class BodyArrays:
-    """One body's corners in its own frame: (3F, 3) positions and normals, (3F,) palette indices."""
+    """One body's corners in its own frame: (3F, 3) positions and normals, (3F,) material indices,
+    (3F, 2) texture coordinates."""
     local: np.ndarray
     normals: np.ndarray
     materials: np.ndarray
+    uvs: np.ndarray
 
 
 def palette_arrays(mesh: Mesh) -> BodyArrays:
     """Corners, crease-aware normals and palette indices of a palette-coloured model."""
-    face_n, valid = trimesh.triangles.normals(mesh.vertices[mesh.faces])
-    face_n = _scatter(face_n, valid, len(mesh.faces))
-    summed = np.zeros((len(mesh.vertices), 3))
-    np.add.at(summed, mesh.faces, face_n[:, None, :])       # trimesh's mean without scipy.sparse
+    return BodyArrays(mesh.vertices[mesh.faces.ravel()], corner_normals(mesh.vertices, mesh.faces),
+                      np.repeat(mesh.colours, 3), np.zeros((3 * len(mesh.faces), 2)))
+
+
+def model_arrays(fitted: FittedModel, slots: np.ndarray) -> BodyArrays:
+    """Corners, normals, material slots (``slots[k]``: the table index of the model's material k)
+    and texture coordinates of a fitted library model."""
+    faces = fitted.model.faces
+    return BodyArrays(fitted.vertices[faces.ravel()], corner_normals(fitted.vertices, faces),
+                      np.repeat(slots[fitted.model.face_material], 3), fitted.model.uvs[faces.ravel()])
+
+
+def corner_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(3F, 3) normals: smooth across gentle bends, flat across creases (CREASE_COS)."""
+    face_n, valid = trimesh.triangles.normals(vertices[faces])
+    face_n = _scatter(face_n, valid, len(faces))
+    summed = np.zeros((len(vertices), 3))
+    np.add.at(summed, faces, face_n[:, None, :])            # trimesh's mean without scipy.sparse
     vertex_n = trimesh.util.unitize(summed)
     corner_face_n = np.repeat(face_n, 3, axis=0)
-    corner_vertex_n = vertex_n[mesh.faces.ravel()]
+    corner_vertex_n = vertex_n[faces.ravel()]
     smooth = np.einsum("ij,ij->i", corner_face_n, corner_vertex_n) > CREASE_COS
-    normals = np.where(smooth[:, None], corner_vertex_n, corner_face_n)
-    return BodyArrays(mesh.vertices[mesh.faces.ravel()], normals, np.repeat(mesh.colours, 3))
+    return np.where(smooth[:, None], corner_vertex_n, corner_face_n)
 
 
 def _scatter(normals: np.ndarray, valid: np.ndarray, count: int) -> np.ndarray:
@@ -67,8 +83,8 @@ class SceneBuilder:
 
     def __init__(self, world: World, materials: MaterialTable) -> None:
         self.world, self.materials = world, materials
-        self._palette: dict[int, BodyArrays] = {}          # id(mesh) -> its arrays
-        self._meshes: dict[int, Mesh] = {}                  # keeps those meshes alive (ids stay unique)
+        self._arrays: dict[int, BodyArrays] = {}           # id(mesh or fitted model) -> its arrays
+        self._kept: dict[int, Mesh | FittedModel] = {}      # keeps those alive (ids stay unique)
 
     def build(self) -> np.ndarray:
         """(3T, FLOATS_PER_VERTEX) float32 of every visible body, in instance order."""
@@ -78,6 +94,9 @@ class SceneBuilder:
             if visual is None:
                 continue
             chunks.append(self._body(visual, inst.name, inst.id))
+        shown = {id(v.model if v.model is not None else v.mesh) for v in self.world.visuals.values()}
+        for key in set(self._arrays) - shown:              # models swapped out: forget their arrays
+            del self._arrays[key], self._kept[key]
         return np.concatenate(chunks).astype(np.float32)
 
     def _body(self, visual: Visual, name: str, instance_id: int) -> np.ndarray:
@@ -86,22 +105,28 @@ class SceneBuilder:
             corners = mesh.vertices[mesh.faces.ravel()]
             normals = mesh.normals[mesh.faces.ravel()]
             material = np.full(len(corners), self.materials.paint(visual.paint, visual.surface), np.float64)
-            return _pack(corners, normals, corners, material, instance_id)
-        assert visual.mesh is not None
-        key = id(visual.mesh)
-        if key not in self._palette:
-            self._palette[key] = palette_arrays(visual.mesh)
-            self._meshes[key] = visual.mesh
-        arrays = self._palette[key]
+            return _pack(corners, normals, corners, material, instance_id, np.zeros((len(corners), 2)))
+        source = visual.model if visual.model is not None else visual.mesh
+        assert source is not None
+        key = id(source)
+        if key not in self._arrays:
+            if isinstance(source, FittedModel):
+                slots = np.array([self.materials.library(source.model.id, k, m)
+                                  for k, m in enumerate(source.model.materials)])
+                self._arrays[key] = model_arrays(source, slots)
+            else:
+                self._arrays[key] = palette_arrays(source)
+            self._kept[key] = source
+        arrays = self._arrays[key]
         pose = pose_matrix(*self.world.object_pose(name))
         world_pos = arrays.local @ pose[:, :3].T + pose[:, 3]
         return _pack(world_pos, arrays.normals @ pose[:, :3].T, arrays.local,
-                     arrays.materials.astype(np.float64), instance_id)
+                     arrays.materials.astype(np.float64), instance_id, arrays.uvs)
 
 
 def _pack(position: np.ndarray, normal: np.ndarray, local: np.ndarray, material: np.ndarray,
-          instance_id: int) -> np.ndarray:
+          instance_id: int, uvs: np.ndarray) -> np.ndarray:
     out = np.empty((len(position), FLOATS_PER_VERTEX), np.float64)
     out[:, 0:3], out[:, 3:6], out[:, 6:9] = position, normal, local
-    out[:, 9], out[:, 10] = material, instance_id
+    out[:, 9], out[:, 10], out[:, 11:13] = material, instance_id, uvs
     return out

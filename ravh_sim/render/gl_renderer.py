@@ -48,6 +48,7 @@ PROBE_HEIGHT = 1.3                    # m above the floor where a room's probe s
 PROBE_FAR = 30.0
 FACE_AXES = (((1, 0, 0), (0, 0, 1)), ((-1, 0, 0), (0, 0, 1)), ((0, 1, 0), (0, 0, 1)),
              ((0, -1, 0), (0, 0, 1)), ((0, 0, 1), (0, 1, 0)), ((0, 0, -1), (0, 1, 0)))
+SHADOW_FORMAT = "3f 3x4 3x4 1f 1x4 2x4"  # position and material of each vertex (geometry.VERTEX_FORMAT)
 COVERAGE_TEXELS = 512
 ROOM_MAP_RESOLUTION = 0.05            # m per cell of the floor-plan room map
 COVERAGE_BLUR_M = 0.12                # sigma of the floor occlusion blur
@@ -172,6 +173,9 @@ class GLRenderer:
         self._room_box = (origin[0] - ROOM_MAP_RESOLUTION / 2, origin[1] - ROOM_MAP_RESOLUTION / 2,
                           1.0 / width_m, 1.0 / height_m)
         self.vbo: moderngl.Buffer | None = None
+        self.material_texture: moderngl.Texture | None = None
+        self.library_textures: moderngl.TextureArray | None = None
+        self._library_layers: list[str] | None = None
         self.vaos: dict[str, moderngl.VertexArray] = {}
         self._room_vaos: dict[str, tuple[moderngl.VertexArray, moderngl.VertexArray, moderngl.Buffer]] = {}
         self._geometry_revision = -1
@@ -190,6 +194,7 @@ class GLRenderer:
                     self.ldr_fbo, self.sun_depth, self.sun_fbo, self.coverage_raw, self.coverage_fbo,
                     self.coverage, self.noise, self.room_map, self.room_light, self.instance_texture,
                     self.probes, self.probe_fbo, self.probe_boxes, self.atlas, self.atlas_fbo, self.vbo,
+                    self.material_texture, self.library_textures,
                     *self.vaos.values(),
                     *(obj for subset in self._room_vaos.values() for obj in subset)):
             if obj is not None:
@@ -252,18 +257,40 @@ class GLRenderer:
                     obj.release()
         self.vbo = self.ctx.buffer(vertices.tobytes())
         self._room_vaos = self._room_subsets(vertices)
-        skip = "3f 3x4 3x4 1f 1x4"
         self.vaos = {
-            **{f"scene{k}": self.ctx.vertex_array(self.scene_programs[k], [(self.vbo, VERTEX_FORMAT, *ATTRIBUTES)])
-               for k, _, _ in self._ranges},
-            "depth": self.ctx.vertex_array(self.depth_program, [(self.vbo, "3f 32x", "in_position")]),
-            "shadow": self.ctx.vertex_array(self.shadow_program, [(self.vbo, skip, "in_position", "in_material")]),
+            **{f"scene{k}": self._scene_vao(self.scene_programs[k]) for k, _, _ in self._ranges},
+            "depth": self.ctx.vertex_array(self.depth_program, [(self.vbo, "3f 40x", "in_position")]),
+            "shadow": self.ctx.vertex_array(self.shadow_program, [(self.vbo, SHADOW_FORMAT, "in_position",
+                                                                   "in_material")]),
             "coverage": self.ctx.vertex_array(self.coverage_program, [
-                (self.vbo, "3f 3x4 3x4 1x4 1f", "in_position", "in_instance")]),
+                (self.vbo, "3f 3x4 3x4 1x4 1f 2x4", "in_position", "in_instance")]),
         }
         table = self.materials.pack()
+        if self.material_texture is not None:
+            self.material_texture.release()
         self.material_texture = self.ctx.texture((TEXELS, len(table)), 4, table.tobytes(), dtype="f4")
         self.material_texture.filter = (self.ctx.NEAREST, self.ctx.NEAREST)
+        if self._library_layers != self.materials.textures:
+            self._upload_library_textures()
+
+    def _scene_vao(self, program: moderngl.Program, index_buffer: moderngl.Buffer | None = None
+                   ) -> moderngl.VertexArray:
+        """A shading program's view of the vertex buffer; a pattern's program that reads no texture
+        coordinate has no ``in_uv`` (skipped)."""
+        return self.ctx.vertex_array(program, [(self.vbo, VERTEX_FORMAT, *ATTRIBUTES)],
+                                     index_buffer=index_buffer, skip_errors=True)
+
+    def _upload_library_textures(self) -> None:
+        """The library textures in use as one mipmapped, repeating texture array (layer = the
+        material's ``layer``)."""
+        layers = self.materials.texture_layers()
+        if self.library_textures is not None:
+            self.library_textures.release()
+        count, height, width, _ = layers.shape
+        self.library_textures = self.ctx.texture_array((width, height, count), 3, layers.tobytes())
+        self.library_textures.build_mipmaps()
+        self.library_textures.anisotropy = 4.0
+        self._library_layers = list(self.materials.textures)
 
     def _room_subsets(self, vertices: np.ndarray
                       ) -> dict[str, tuple[moderngl.VertexArray, moderngl.VertexArray, moderngl.Buffer]]:
@@ -279,10 +306,9 @@ class GLRenderer:
             indices = (triangles[:, None] * 3 + np.arange(3)).astype(np.int32).ravel()
             ibo = self.ctx.buffer(indices.tobytes())
             out[room.id] = (
-                self.ctx.vertex_array(self.shadow_program, [(self.vbo, "3f 3x4 3x4 1f 1x4", "in_position",
+                self.ctx.vertex_array(self.shadow_program, [(self.vbo, SHADOW_FORMAT, "in_position",
                                                              "in_material")], index_buffer=ibo),
-                self.ctx.vertex_array(self.scene_programs[PATTERN["plain"]],
-                                      [(self.vbo, VERTEX_FORMAT, *ATTRIBUTES)], index_buffer=ibo),
+                self._scene_vao(self.scene_programs[PATTERN["plain"]], ibo),
                 ibo)
         return out
 
@@ -414,6 +440,7 @@ class GLRenderer:
         ctx = self.ctx
         ctx.enable(ctx.DEPTH_TEST)
         ctx.disable(ctx.CULL_FACE)
+        assert self.material_texture is not None, "uploaded with geometry"
         self.material_texture.use(0)
         _uniform(self.shadow_program, "u_materials").value = 0
         _uniform(self.shadow_program, "u_matrix").write(_mat(matrix))
@@ -506,8 +533,10 @@ class GLRenderer:
     # ------------------------------------------------------------------ frames
     def _bind_textures(self) -> None:
         assert self.instance_texture is not None and self.room_light is not None, "_sync uploads them first"
-        units: tuple[tuple[str, moderngl.Texture | moderngl.Texture3D], ...] = (
-            ("u_materials", self.material_texture), ("u_instances", self.instance_texture),
+        assert self.material_texture is not None and self.library_textures is not None, "uploaded with geometry"
+        units: tuple[tuple[str, moderngl.Texture | moderngl.Texture3D | moderngl.TextureArray], ...] = (
+            ("u_materials", self.material_texture), ("u_library", self.library_textures),
+            ("u_instances", self.instance_texture),
             ("u_sun_shadow", self.sun_depth), ("u_point_shadow", _either(self.atlas, self.depth)),
             ("u_coverage", self.coverage), ("u_noise", self.noise), ("u_room_map", self.room_map),
             ("u_room_light", self.room_light), ("u_probes", _either(self.probes, self.hdr)),

@@ -1,29 +1,36 @@
 """Physically based materials for every palette colour and paint, as the GPU reads them.
 
-Why: the furniture library colours each face with a named palette colour ("wood_dark", "fabric_blue",
+Why: procedural models colour each face with a named palette colour ("wood_dark", "fabric_blue",
 "chrome"...) and rooms are painted with named paints ("parquet", "tiles", "#a0b0c0"). The name already
 says what the surface is made of, so the material follows from it: base colour, roughness, metalness
 and a procedural pattern (wood grain, weave, grout...) that the fragment shader evaluates in the
-surface's own coordinates. No image files: every pattern is a function of position and a seed.
+surface's own coordinates. No image files for those: every pattern is a function of position and a
+seed. Furniture-library models bring their own MTL materials: textured ones sample their texture,
+the others get the procedural material their name says they are (:func:`library_material`).
 
 The table is uploaded as a small float texture: one row of :data:`TEXELS` texels per material.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+import cv2
 import numpy as np
 
+from ravh_sim.paths import FURNITURE_DIR
 from ravh_sim.world import paints
+from ravh_sim.world.library import LibraryMaterial
 from ravh_sim.world.palette import PALETTE
 
 RGB = tuple[float, float, float]
 
 # Pattern ids, mirrored by the PATTERN_* constants in shaders/scene.frag.
 PATTERNS = ("plain", "plaster", "wood", "parquet", "tiles", "marble", "fabric", "leather", "carpet",
-            "brick", "concrete", "metal", "glass", "mirror", "screen", "ceramic", "foliage", "emissive")
+            "brick", "concrete", "metal", "glass", "mirror", "screen", "ceramic", "foliage", "emissive",
+            "textured")
 PATTERN = {name: i for i, name in enumerate(PATTERNS)}
-TEXELS = 3                                   # texels per material row (see pack)
+TEXELS = 4                                   # texels per material row (see pack)
+LIBRARY_TEXELS = 256                         # side of every library texture in the texture array
 
 
 @dataclass(frozen=True)
@@ -36,6 +43,7 @@ class Material:
     variation: float = 0.15                  # how much the pattern varies the base colour
     accent: RGB = (0.0, 0.0, 0.0)            # second colour: grout, veins, dark grain, mortar
     bump: float = 0.3                        # strength of the pattern's normal detail
+    layer: int = -1                          # the texture array layer of a textured material
 
 
 def srgb_to_linear(rgb: RGB) -> RGB:
@@ -144,13 +152,50 @@ def noise_volume() -> np.ndarray:
     return out
 
 
+# What a library material's kind (ravh_sim.world.library.material_kind) is drawn as: the palette
+# colour name whose material family it belongs to.
+_LIBRARY_FAMILY = {"wood": "wood", "fabric": "fabric", "leather": "leather", "metal": "metal",
+                   "mirror": "mirror", "screen": "screen", "ceramic": "ceramic", "marble": "marble",
+                   "plant": "plant", "emissive": "lamp_shade", "plain": "plain"}
+
+
+def library_material(material: LibraryMaterial, layer: int) -> Material:
+    """A library model's MTL material: textured ones sample their texture (layer of the texture
+    array); the others are the procedural material of their kind in their MTL colour. Furniture
+    glass is drawn as dark, glossy glass (there is no see-through)."""
+    colour = srgb_to_linear(material.colour)
+    if material.kind == "textured":
+        return Material((1.0, 1.0, 1.0), "textured", material.roughness, variation=0.0, bump=0.35, layer=layer)
+    if material.kind == "glass":
+        return Material(_scaled(colour, 0.3), "ceramic", 0.05, variation=0.0)
+    family = palette_material(_LIBRARY_FAMILY[material.kind], material.colour)
+    roughness = family.roughness if material.kind != "plain" else material.roughness
+    return replace(family, roughness=roughness)
+
+
 class MaterialTable:
-    """Palette materials at fixed indices, then one slot per distinct (paint, surface) in use."""
+    """Palette materials at fixed indices, then one slot per distinct (paint, surface) and library
+    material in use; library textures get a layer each of one texture array."""
 
     def __init__(self) -> None:
         self.materials: list[Material] = [palette_material(n, tuple(PALETTE.rgb[i]))
                                           for i, n in enumerate(PALETTE.names)]
         self._paint_slots: dict[tuple[str, str], int] = {}
+        self._library_slots: dict[tuple[str, int], int] = {}
+        self.textures: list[str] = []                # library texture files, by layer
+
+    def library(self, model_id: str, index: int, material: LibraryMaterial) -> int:
+        """Material index of a library model's material ``index``."""
+        key = (model_id, index)
+        if key not in self._library_slots:
+            layer = -1
+            if material.texture is not None:
+                if material.texture not in self.textures:
+                    self.textures.append(material.texture)
+                layer = self.textures.index(material.texture)
+            self._library_slots[key] = len(self.materials)
+            self.materials.append(library_material(material, layer))
+        return self._library_slots[key]
 
     def paint(self, paint: str, surface: str) -> int:
         """Material index of a paint on a surface ('walls', 'floor' or 'ceiling')."""
@@ -162,7 +207,24 @@ class MaterialTable:
 
     def pack(self) -> np.ndarray:
         """(len, TEXELS, 4) float32: [colour, pattern], [roughness, metalness, scale, variation],
-        [accent, bump]."""
+        [accent, bump], [texture layer, 0, 0, 0]."""
         rows = [[(*m.colour, PATTERN[m.pattern]), (m.roughness, m.metalness, m.scale, m.variation),
-                 (*m.accent, m.bump)] for m in self.materials]
+                 (*m.accent, m.bump), (m.layer, 0.0, 0.0, 0.0)] for m in self.materials]
         return np.asarray(rows, np.float32)
+
+    def texture_layers(self) -> np.ndarray:
+        """(layers, LIBRARY_TEXELS, LIBRARY_TEXELS, 3) uint8 RGB of the library textures in use (one
+        white layer when there are none), each resized to the array's size, bottom row first (GL's
+        and OBJ's texture coordinates count v from the bottom)."""
+        layers = [np.full((LIBRARY_TEXELS, LIBRARY_TEXELS, 3), 255, np.uint8)]
+        if self.textures:
+            layers = [_texture_rgb(name) for name in self.textures]
+        return np.ascontiguousarray(np.stack(layers)[:, ::-1])
+
+
+def _texture_rgb(name: str) -> np.ndarray:
+    bgr = cv2.imread(str(FURNITURE_DIR / name), cv2.IMREAD_COLOR)
+    if bgr is None:
+        raise FileNotFoundError(f"furniture texture {FURNITURE_DIR / name} is missing or unreadable")
+    size = (LIBRARY_TEXELS, LIBRARY_TEXELS)
+    return cv2.cvtColor(cv2.resize(bgr, size, interpolation=cv2.INTER_AREA), cv2.COLOR_BGR2RGB)

@@ -24,7 +24,7 @@ from ravh_msgs_py.appearance import LIGHT_GROUPS, SUN_PRESETS, SURFACES, SWITCH
 from ravh_msgs_py.query import UNKNOWN_ID, QueryError
 from ravh_sim.errors import UnknownNameError, UserError
 from ravh_sim.world import paints
-from ravh_sim.world.furniture import variant_count
+from ravh_sim.world.solids import model_count
 from ravh_sim.world.scene import World
 from ravh_sim.world.settings import Resolved, light_group, load_settings, resolve
 
@@ -139,7 +139,7 @@ class Appearance:
             index = model
         else:
             raise UserError(f"model must be an index, 'random' or {{'inherit': ID}}, got {model!r}")
-        count = variant_count(obj.type)
+        count = model_count(obj)
         if not 0 <= index < count:
             raise UserError(f"{object_id}: model index must be in 0..{count - 1}, got {index}")
         if index != self.state.models[object_id]:

@@ -35,6 +35,7 @@ from ravh_sim.render.backend import resolve_backend
 from ravh_sim.world import paints
 from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances
 from ravh_sim.world.house import House, HouseObject, Wall
+from ravh_sim.world.library import FittedModel, palette_stand_in
 from ravh_sim.world.mesh import Mesh, hulls_obj_text
 from ravh_sim.world.palette import PALETTE
 from ravh_sim.world.settings import Resolved
@@ -202,14 +203,26 @@ class World:
         """The object's model, colliding part by part (see :mod:`ravh_sim.world.solids`); a door is
         its leaf, which :meth:`place_door` then puts in the doorway or out of the house."""
         placed = object_parts(self.house, obj, model)
-        collision = -1 if obj.type in NON_SOLID_TYPES else self._parts_collision(placed)
-        mesh = placed.mesh()
+        if obj.type in NON_SOLID_TYPES:
+            collision = -1
+        elif placed.model is not None:
+            collision = self._model_collision(placed.model)
+        else:
+            collision = self._parts_collision(placed)
+        mesh = placed.mesh() if placed.model is None else palette_stand_in(placed.model)
         path = self._asset(mesh_bytes(mesh), ".obj", lambda p: mesh.write_obj(p, PALETTE))
         body = self._file_body(path, collision, placed.position, placed.yaw)
         self._set_look(body, self._texture("palette"), [1, 1, 1, 1])
-        self.visuals[body] = Visual(mesh=mesh)
+        self.visuals[body] = Visual(mesh=mesh if placed.model is None else None, model=placed.model)
         self.triangle_count += mesh.triangle_count
         return body
+
+    def _model_collision(self, fitted: FittedModel) -> int:
+        """A library model collides as its own triangles (a static concave mesh: exact for the laser,
+        which then sees what the camera draws)."""
+        return pb.createCollisionShape(pb.GEOM_MESH, vertices=fitted.vertices.tolist(),
+                                       indices=fitted.model.faces.ravel().tolist(),
+                                       flags=pb.GEOM_FORCE_CONCAVE_TRIMESH, physicsClientId=self.client)
 
     def _parts_collision(self, placed: Placed) -> int:
         """A compound of one convex hull per model part, loaded from a cached OBJ file."""
@@ -310,9 +323,10 @@ class World:
 
 @dataclass
 class Visual:
-    """What a body looks like: a palette-coloured model (in its body frame) or a painted piece of
-    structure (in the house frame) with its current paint."""
+    """What a body looks like: a palette-coloured model or a fitted library model (in its body
+    frame), or a painted piece of structure (in the house frame) with its current paint."""
     mesh: Mesh | None = None
+    model: FittedModel | None = None
     structure: TexturedMesh | None = None
     surface: str = ""                      # walls | floor | ceiling for structure
     paint: str = ""

@@ -28,7 +28,7 @@ from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
 from ravh_sim.paths import DEFAULT_CONFIG, ROBOTS_DIR
 from ravh_sim.schema import Strict, read_text, shown, validate
 from ravh_sim.world import paints
-from ravh_sim.world.furniture import variant_count
+from ravh_sim.world.solids import model_count
 from ravh_sim.world.house import House, Light
 
 DOOR_STATES = ("default", *DOOR)          # a settings file may also keep a door as the house has it
@@ -296,13 +296,13 @@ def _paint(value: str, room_type: str, surface: str, rng: random.Random) -> str:
 def _resolve_models(cfg: dict, house: House, pick: _Picker, source: str) -> dict[str, int]:
     per_object = _per_item(cfg, "models.set", house.object_by_id, "object", source)
     if isinstance(cfg["all"], int) and house.objects:
-        _index(cfg["all"], max(variant_count(o.type) for o in house.objects), source, "models.all")
+        _index(cfg["all"], max(model_count(o) for o in house.objects), source, "models.all")
     explicit: dict[str, int] = {}
     inherit_from: dict[str, str] = {}
     for obj in house.objects:
         key = f"models.set.{obj.id}" if obj.id in per_object else "models.all"
         value = per_object.get(obj.id, cfg["all"])
-        count = variant_count(obj.type)
+        count = model_count(obj)
         if isinstance(value, dict) and set(value) == {"inherit"}:
             inherit_from[obj.id] = str(house.object(value["inherit"]).id)
             continue

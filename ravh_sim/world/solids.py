@@ -6,8 +6,11 @@ free-space map blocks the floor under the parts that a robot's body would hit (a
 a tall robot; the empty corner of an L-shaped sofa does not). Physics, sensors and navigation then
 agree on every surface because they read the same parts.
 
-A :class:`Placed` object holds its parts in its body frame (box centre at the origin, unrotated)
-and the body's pose; the world turns it by ``yaw`` about z and moves it to ``position``.
+A :class:`Placed` object holds its model in its body frame (box centre at the origin, unrotated)
+and the body's pose; the world turns it by ``yaw`` about z and moves it to ``position``. The model is
+a furniture-library model (:mod:`ravh_sim.world.library`: modelled, textured, colliding as its own
+triangles) where the library has one of the object's kind, else procedural convex parts
+(:mod:`ravh_sim.world.furniture`: doors, windows, worktops, pictures, mirrors, the station).
 """
 from __future__ import annotations
 
@@ -19,7 +22,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ravh_sim.world.facing import choose_facing
-from ravh_sim.world.furniture import build_parts, front_axis
+import trimesh
+
+from ravh_sim.world import library
+from ravh_sim.world.furniture import build_parts, front_axis, variant_count
 from ravh_sim.world.house import Door, House, HouseObject
 from ravh_sim.world.mesh import Mesh, box
 from ravh_sim.world.palette import PALETTE
@@ -29,6 +35,7 @@ DOOR_LEAF_THICKNESS = 0.05
 """m: the door leaf model's thickness (the doorway's frame is part of the walls)."""
 JAMB_COLOUR = "white"
 _Y = np.array([0.0, 1.0, 0.0])             # a door body's axis along the doorway
+MAX_FOOTPRINT_BOXES = 48                   # a library model's floor footprint: its largest pieces' boxes
 
 Footprint = tuple[tuple[float, float], tuple[float, float], float]
 """A yawed rectangle on the floor: centre (x, y), size (along yaw, across), yaw."""
@@ -36,15 +43,21 @@ Footprint = tuple[tuple[float, float], tuple[float, float], float]
 
 @dataclass(frozen=True)
 class Placed:
-    """An object's model parts in its body frame and the body's pose in the house."""
+    """An object's model in its body frame and the body's pose in the house: procedural convex
+    ``parts``, or a fitted library ``model`` (then ``parts`` is empty)."""
     parts: tuple[Mesh, ...]
-    bounds: np.ndarray                     # (parts, 2, 3): each part's min and max corner
+    bounds: np.ndarray                     # (pieces, 2, 3): each part's (or model piece's) min and max corner
     position: tuple[float, float, float]
     yaw: float
+    model: library.FittedModel | None = None
 
     def mesh(self) -> Mesh:
-        """The parts merged: what the camera draws."""
+        """The procedural parts merged: what the camera draws of them."""
         return Mesh.merged(self.parts)
+
+    def extent(self) -> tuple[np.ndarray, np.ndarray]:
+        """(min corner, max corner) of everything the object is, in its body frame."""
+        return self.bounds[:, 0].min(axis=0), self.bounds[:, 1].max(axis=0)
 
     def footprints(self, z_low: float, z_high: float, min_size: float = 0.0) -> Iterator[Footprint]:
         """Floor rectangles (in the body's yawed frame) of the parts that reach into the height
@@ -74,8 +87,18 @@ def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
     walls = tuple((w.a, w.b) for w in house.walls if w.room == obj.room and w.kind != "lintel")
     facing = _facing(tuple(box.position[:2]), obj.yaw, tuple(box.size), walls, front_axis(obj.type))
     variant = obj.default_model if model is None else model
+    records = library.models_of(library.kind_of(obj.type, obj.prefab))
+    if records:
+        fitted, bounds = _fitted(records[variant % len(records)].id, tuple(box.size), facing)
+        return Placed((), bounds, box.position, obj.yaw, fitted)
     parts, bounds = _parts(obj.type, tuple(box.size), variant, facing, obj.prefab)
     return Placed(parts, bounds, box.position, obj.yaw)
+
+
+def model_count(obj: HouseObject) -> int:
+    """How many models the Object Models setting chooses among for ``obj``: its kind's library
+    models, or the procedural variants of its type."""
+    return len(library.models_of(library.kind_of(obj.type, obj.prefab))) or variant_count(obj.type)
 
 
 def door_parts(house: House, door: Door, model: int | None) -> Placed:
@@ -106,6 +129,62 @@ def _parts(object_type: str, size: tuple[float, float, float], variant: int, fac
     change ask again."""
     parts = tuple(build_parts(object_type, np.asarray(size), variant, facing, prefab))
     return parts, np.array([part.bounds() for part in parts])
+
+
+@functools.lru_cache(maxsize=1024)
+def _fitted(model_id: str, size: tuple[float, float, float], facing: int
+            ) -> tuple[library.FittedModel, np.ndarray]:
+    """A library model fitted into a box (turned to ``facing`` as procedural models are) and the
+    boxes of its largest pieces, cached like :func:`_parts`."""
+    extents = np.asarray(size, np.float64)
+    d, w, h = extents[[0, 1, 2] if facing % 2 == 0 else [1, 0, 2]]
+    model = library.load_model(model_id)
+    turn = trimesh.transformations.rotation_matrix(facing * np.pi / 2, (0, 0, 1))[:3, :3]
+    vertices = library.fit(model, np.array([d, w, h])) @ turn.T
+    return library.FittedModel(model, vertices), _piece_bounds(vertices, model.faces)
+
+
+def _piece_bounds(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(pieces, 2, 3) boxes of a model's connected pieces (legs, seat, back...), the largest
+    MAX_FOOTPRINT_BOXES kept and every smaller piece merged into the nearest kept box, so the
+    boxes cover the model and the free-space map sees between its legs."""
+    labels = _piece_labels(vertices, faces)
+    corners = vertices[faces]                                    # (M, 3, 3)
+    count = int(labels.max()) + 1
+    lo = np.full((count, 3), np.inf)
+    hi = np.full((count, 3), -np.inf)
+    np.minimum.at(lo, labels, corners.min(axis=1))
+    np.maximum.at(hi, labels, corners.max(axis=1))
+    order = np.argsort(-np.prod(np.maximum(hi - lo, 1e-3), axis=1), kind="stable")
+    keep, rest = order[:MAX_FOOTPRINT_BOXES], order[MAX_FOOTPRINT_BOXES:]
+    lo_k, hi_k = lo[keep].copy(), hi[keep].copy()
+    centres = (lo_k + hi_k) / 2
+    for piece in rest:
+        nearest = int(np.argmin(np.linalg.norm(centres - (lo[piece] + hi[piece]) / 2, axis=1)))
+        lo_k[nearest] = np.minimum(lo_k[nearest], lo[piece])
+        hi_k[nearest] = np.maximum(hi_k[nearest], hi[piece])
+    return np.stack([lo_k, hi_k], axis=1)
+
+
+def _piece_labels(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Per face, the connected piece it belongs to (faces touching at a vertex position are one
+    piece, across texture seams): union-find over the faces' corners."""
+    _, corner = np.unique(np.round(vertices, 5), axis=0, return_inverse=True)
+    corner = corner.reshape(-1)[faces]                           # (M, 3) position ids
+    parent = np.arange(int(corner.max()) + 1)
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for a, b, c in corner.tolist():
+        ra, rb, rc = root(a), root(b), root(c)
+        parent[rb] = ra
+        parent[rc] = ra
+    roots = np.array([root(i) for i in range(len(parent))])
+    return np.unique(roots[corner[:, 0]], return_inverse=True)[1].reshape(-1)
 
 
 @functools.lru_cache(maxsize=8192)

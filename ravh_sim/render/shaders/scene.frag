@@ -8,6 +8,7 @@ in vec3 v_world;
 in vec3 v_normal;
 in vec3 v_local;
 in float v_eye_z;
+in vec2 v_uv;
 flat in int v_material;
 flat in int v_instance;
 layout(location = 0) out vec4 out_hdr;
@@ -15,6 +16,7 @@ layout(location = 1) out float out_depth;
 layout(location = 2) out int out_instance;
 
 uniform sampler2D u_materials;        // TEXELS x materials
+uniform sampler2DArray u_library;     // library models' textures, one layer each (sRGB)
 uniform sampler2D u_instances;        // instances x 3: room, emission+kind, floor/ceiling z
 uniform sampler2D u_room_map;         // floor plan: room index + 1 per cell, 0 outside
 uniform vec4 u_room_box;              // x0, y0, 1/width, 1/height in metres
@@ -55,7 +57,7 @@ vec2 planar(vec3 p, vec3 n) {
     return n.z > 0.7 ? p.xy : (n.x > n.y ? p.yz : p.xz);
 }
 
-Surface pattern(vec3 base, vec3 accent, float rough, float metal, float scale, float variation, vec3 p) {
+Surface pattern(vec3 base, vec3 accent, float rough, float metal, float scale, float variation, vec3 p, float layer) {
     vec3 n = face_normal_local();
     vec2 uv = planar(p, n);
     Surface s = Surface(base, rough, metal, 0.0);
@@ -158,6 +160,13 @@ Surface pattern(vec3 base, vec3 accent, float rough, float metal, float scale, f
         s.albedo = base * (0.92 + 0.16 * brushed);
         s.roughness = rough * (0.8 + 0.4 * brushed);
         s.height = brushed * 0.3;
+    }
+#elif PATTERN_ID == PATTERN_TEXTURED
+    {
+        // A library model's texture (sRGB), tiling as its UVs say; its detail doubles as relief.
+        vec3 texel = texture(u_library, vec3(v_uv, layer)).rgb;
+        s.albedo = base * pow(texel, vec3(2.2));
+        s.height = luminance(texel);
     }
 #elif PATTERN_ID == PATTERN_FOLIAGE
     {
@@ -266,6 +275,7 @@ void main() {
     vec4 m0 = texelFetch(u_materials, ivec2(0, v_material), 0);
     vec4 m1 = texelFetch(u_materials, ivec2(1, v_material), 0);
     vec4 m2 = texelFetch(u_materials, ivec2(2, v_material), 0);
+    float layer = texelFetch(u_materials, ivec2(3, v_material), 0).r;
     vec4 instance_room = texelFetch(u_instances, ivec2(v_instance, 0), 0);
     vec4 emission_kind = texelFetch(u_instances, ivec2(v_instance, 1), 0);
     vec4 levels = texelFetch(u_instances, ivec2(v_instance, 2), 0);
@@ -281,7 +291,7 @@ void main() {
     if (room < 0) room = int(instance_room.a + 0.5);
     vec3 ambient = texelFetch(u_room_light, ivec2(room, 0), 0).rgb;
     vec3 seeded = v_local + (kind >= KIND_OBJECT ? hash12(vec2(float(v_instance), 1.0)) * 37.0 : 0.0);
-    Surface s = pattern(m0.rgb, m2.rgb, m1.x, m1.y, m1.z, m1.w, seeded);
+    Surface s = pattern(m0.rgb, m2.rgb, m1.x, m1.y, m1.z, m1.w, seeded, layer);
     n = bumped(n, v_world, s.height, m2.a);
 
     vec3 colour;

@@ -1,0 +1,455 @@
+"""``ravh import-furniture``: the furniture library built from Sweet Home 3D's open catalogues.
+
+Why: a detector trained on photos recognises modelled furniture, not boxes. Sweet Home 3D's
+catalogues (Debian's ``sweethome3d-furniture`` and the default catalogue in ``sweethome3d.jar``) are
+the standard open library of home furniture: zip archives of OBJ + MTL + textures with a
+``*FurnitureCatalog.properties`` that names every model, its category, size, creator and licence.
+
+This maintainer's tool (like ``ravh import-houses``) picks models for our object types by name and
+category (:data:`RULES`), turns them into our frame (Sweet Home 3D models are Y-up with their front
+towards +z, scaled to the catalogue's width/depth/height in cm; ours are z-up, front along +x, in
+metres, centred on their box), simplifies each to :data:`TRIANGLE_BUDGET` triangles, shrinks
+textures to :data:`TEXTURE_TEXELS` and writes the compact committed set under ``furniture/`` (see
+:mod:`ravh_sim.world.library` for the format and its reader) with ``ATTRIBUTION.md``. Users never
+need the catalogues: the committed set is all the simulator reads.
+"""
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import re
+import shutil
+import zipfile
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path, PurePosixPath
+
+import cv2
+import numpy as np
+import trimesh
+
+from ravh_sim.errors import UserError
+from ravh_sim.world.library import CATALOG_FORMAT, LibraryMaterial, material_kind
+
+TRIANGLE_BUDGET = 4000
+"""Triangles of a model 1.5 m or larger after simplification (smaller ones get a share in proportion
+to their size, at least MIN_TRIANGLES): a 640x480 frame shows a sofa over ~300 px, where 4k
+triangles already put several triangles per silhouette pixel; a house of ~100 objects then stays
+near 200k triangles, which the renderer's rebuild on a model change and llvmpipe handle."""
+MIN_TRIANGLES = 600
+TEXTURE_TEXELS = 256
+"""Longest texture side: fabric, wood and labels tile or cover a few hundred pixels in a frame."""
+MAX_PER_TYPE = 4
+DROPPED_OPACITY = 0.35
+"""Materials at most this opaque (clear glass panes) are left out: no sensor of ours sees them."""
+
+INDOOR = ("Bathroom", "Bedroom", "Kitchen", "Living room", "Office", "Lights", "Miscellaneous")
+
+
+@dataclass(frozen=True)
+class Rule:
+    """Which catalogue entries model one of our object kinds: a name pattern, categories, exclusions."""
+    name: str
+    categories: tuple[str, ...] = INDOOR
+    exclude: str = r"$^"
+
+
+RULES: dict[str, Rule] = {
+    "Armchair": Rule(r"armchair$|^armchair", exclude=r"ottoman|rattan|office"),
+    "Bathtub": Rule(r"^bath$|bathtub|^fitted bath|^island bath"),
+    "Bed": Rule(r"^bed\b|^double bed|^iron bed|^captain's bed", ("Bedroom",), exclude=r"side|bunk|loft|child|baby|sofa"),
+    "Brush": Rule(r"^toilet brush$|^brush$", ("Bathroom",)),
+    "Burner": Rule(r"cooktop|induction cooker|^hob"),
+    "Cabinet": Rule(r"^cupboard$|glass door cabinet|^chest$|filing cabinet", exclude=r"kitchen"),
+    "Chair": Rule(r"^chair$|^oak chair$|chair with cushion|^osaka chair", ("Living room", "Kitchen")),
+    "Chair/office": Rule(r"chair|armchair", ("Office",), exclude=r"class|child"),
+    "Closet": Rule(r"^wardrobe$"),
+    "Cup": Rule(r"^coffee cup$|^coffee mug$|^cup$"),
+    "Decoration": Rule(r"^plant$|little plant|indoor plant|yucca|succulent|spider plant|cactus"),
+    "Decoration/vase": Rule(r"^vase$"),
+    "Desk": Rule(r"^desk$|wooden desk|^desk table"),
+    "Dishwasher": Rule(r"dishwasher"),
+    "Dresser": Rule(r"^dresser|chest of drawers|drawers cabinet|^chest$", exclude=r"kitchen"),
+    "Drying": Rule(r"towel rack|radiator"),
+    "Keyboard": Rule(r"^keyboard$"),
+    "KitchenFurniture": Rule(r"^lower cabinet$|^kitchen cabinet$|^drawers cabinet$", ("Kitchen",)),
+    "KitchenFurniture/upper": Rule(r"upper cabinet", ("Kitchen",), exclude=r"corner|shelves"),
+    "KitchenFurniture/corner": Rule(r"lower corner cabinet|^lower cabinet$|^kitchen cabinet$", ("Kitchen",)),
+    "KitchenFurniture/corner_upper": Rule(r"upper corner cabinet|upper cabinet", ("Kitchen",)),
+    "KitchenFurniture/sink": Rule(r"^sink cabinet$|^lower cabinet$|^kitchen cabinet$", ("Kitchen",)),
+    "KitchenFurniture/stove": Rule(r"^cooker$|^stove$|^oven$", ("Kitchen",)),
+    "Lamp": Rule(r"^lamp$|little lamp|desk lamp|floor uplight|pedestal vase lamp", ("Lights",)),
+    "Laptop": Rule(r"^laptop$|ibook"),
+    "Light": Rule(r"ceiling lamp|pendant lamp|hanging light", ("Lights",)),
+    "Microwave": Rule(r"microwave"),
+    "Nightstand": Rule(r"bedside table|night ?stand|night table"),
+    "Oven": Rule(r"^oven$|^small oven$|^double oven$"),
+    "Pouf": Rule(r"pouf|ottoman|footstool"),
+    "Refrigerator": Rule(r"fridge|refrigerator"),
+    "Shelf": Rule(r"^shelves$|^vertical shelves$|wall shelf"),
+    "ShowerCabin": Rule(r"^shower$|shower stall|shower cabin"),
+    "Sink": Rule(r"^sink$", ("Kitchen",)),
+    "Sofa": Rule(r"^sofa|^couch$|winchester sofa|burlap sofa|clear sofa|^futon couch",
+                 exclude=r"convertible|rattan|corner"),
+    "Standard": Rule(r"bookcase|^shelves$"),
+    "Standard/tv": Rule(r"tv unit|tv stand|television cabinet"),
+    "Stool": Rule(r"stool", exclude=r"piano|foot"),
+    "Table": Rule(r"^table$|^oak table$|^square table$|^round table$|wooden (alder |teak )?table", exclude=r"children"),
+    "Table/small": Rule(r"coffee table|^glass table$"),
+    "Toilet": Rule(r"toilets? unit|^toilet$"),
+    "Towel": Rule(r"^towel$"),
+    "Tv": Rule(r"^tv|flat tv|wall flat tv", exclude=r"unit|stand|remote|cabinet"),
+    "Washbasin": Rule(r"washbasin|^basin$|small lavatory|vanity", ("Bathroom",), exclude=r"double"),
+    "WashingMachine": Rule(r"washing machine"),
+}
+"""Our object kinds (``Type`` or ``Type/prefab-class``, see :func:`ravh_sim.world.library.kind_of`)."""
+
+
+# --- reading the catalogues --------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Entry:
+    """One catalogue model: where it is and what the catalogue says of it."""
+    archive: Path
+    catalogue: str
+    id: str
+    name: str
+    category: str
+    creator: str
+    licence: str
+    model: str                          # path of the OBJ inside the archive
+    size_cm: tuple[float, float, float]  # width (x), depth (z), height (y)
+    rotation: tuple[float, ...] | None   # modelRotation: a row-major 3x3 matrix
+    door_or_window: bool
+
+
+def read_properties(text: str) -> dict[str, str]:
+    """A Java ``.properties`` file as a dict (``key=value`` lines, ``\\uXXXX`` escapes, comments)."""
+    out = {}
+    for line in text.splitlines():
+        line = line.strip()
+        if not line or line[0] in "#!" or "=" not in line:
+            continue
+        key, value = line.split("=", 1)
+        out[key.strip()] = re.sub(r"\\u([0-9a-fA-F]{4})", lambda m: chr(int(m.group(1), 16)), value.strip())
+    return out
+
+
+def catalogue_entries(archive: Path) -> list[Entry]:
+    """The models of one ``.sh3f`` or ``.jar`` archive."""
+    with zipfile.ZipFile(archive) as zf:
+        names = [n for n in zf.namelist() if re.search(r"(^|/)\w*FurnitureCatalog\.properties$", n)]
+        if not names:
+            raise UserError(f"{archive}: no *FurnitureCatalog.properties: not a furniture catalogue")
+        props = read_properties(zf.read(names[0]).decode("latin-1"))
+    numbers = sorted({int(k.split("#")[1]) for k in props if k.startswith("id#")})
+    entries = []
+    for i in numbers:
+        def get(key: str, default: str = "") -> str:
+            return props.get(f"{key}#{i}", default)
+        try:
+            size = (float(get("width")), float(get("depth")), float(get("height")))
+        except ValueError:
+            continue
+        rotation = tuple(float(v) for v in get("modelRotation").split()) or None
+        entries.append(Entry(archive, archive.stem, get("id"), get("name"), get("category"),
+                             get("creator", props.get("creator", "")),
+                             get("license", props.get("license", "")).strip(), get("model").lstrip("/"),
+                             size, rotation if rotation and len(rotation) == 9 else None,
+                             get("doorOrWindow") == "true"))
+    return entries
+
+
+@dataclass
+class ObjModel:
+    """An OBJ's triangles grouped by material, with the MTL materials and their texture bytes."""
+    vertices: np.ndarray                 # (N, 3)
+    uvs: np.ndarray                      # (N, 2); zeros where the OBJ has none
+    faces: np.ndarray                    # (M, 3) into vertices
+    face_material: np.ndarray            # (M,) index into materials
+    materials: list[dict] = field(default_factory=list)   # name, Kd, Ns, d, map_Kd (bytes or None)
+
+
+def read_obj(zf: zipfile.ZipFile, path: str) -> ObjModel:
+    """Parse an OBJ (v, vt, f with any polygon, usemtl, mtllib) and its MTL files from an archive.
+
+    Corners are split per (v, vt) pair so each vertex has one texture coordinate; polygons become
+    triangle fans, as Sweet Home 3D reads them.
+    """
+    base = PurePosixPath(path).parent
+    positions: list[list[float]] = []
+    texcoords: list[list[float]] = []
+    corner_index: dict[tuple[int, int], int] = {}
+    vertices: list[int] = []
+    uvs: list[int] = []
+    faces: list[list[int]] = []
+    face_material: list[int] = []
+    material_names: list[str] = []
+    libraries: list[str] = []
+    current = _material_slot(material_names, "default")
+    for raw in zf.read(path).decode("latin-1").splitlines():
+        parts = raw.split()
+        if not parts:
+            continue
+        tag = parts[0]
+        if tag == "v":
+            positions.append([float(p) for p in parts[1:4]])
+        elif tag == "vt":
+            texcoords.append([float(p) for p in (parts[1:3] + ["0"])[:2]])
+        elif tag == "f":
+            corners = []
+            for token in parts[1:]:
+                fields = token.split("/")
+                v = int(fields[0])
+                v = v - 1 if v > 0 else len(positions) + v
+                t = int(fields[1]) if len(fields) > 1 and fields[1] else 0
+                t = t - 1 if t > 0 else (len(texcoords) + t if t < 0 else -1)
+                key = (v, t)
+                if key not in corner_index:
+                    corner_index[key] = len(vertices)
+                    vertices.append(v)
+                    uvs.append(t)
+                corners.append(corner_index[key])
+            for k in range(1, len(corners) - 1):
+                faces.append([corners[0], corners[k], corners[k + 1]])
+                face_material.append(current)
+        elif tag == "usemtl" and len(parts) > 1:
+            current = _material_slot(material_names, " ".join(parts[1:]))
+        elif tag == "mtllib":
+            libraries += parts[1:]
+    mtl = {}
+    for library in libraries:
+        name = str(base / library)
+        if name in zf.namelist():
+            mtl.update(_read_mtl(zf, name, base))
+    xyz = np.asarray(positions, np.float64).reshape(-1, 3)
+    st = np.asarray(texcoords, np.float64).reshape(-1, 2)
+    uv_index = np.asarray(uvs, np.int64)
+    corner_uv = np.zeros((len(uv_index), 2))
+    if len(st):
+        corner_uv = np.where((uv_index >= 0)[:, None], st[np.clip(uv_index, 0, len(st) - 1)], 0.0)
+    materials = [mtl.get(name, {"name": name, "Kd": (0.7, 0.7, 0.7), "Ns": 10.0, "d": 1.0, "map_Kd": None})
+                 for name in material_names]
+    return ObjModel(xyz[np.asarray(vertices, np.int64)], corner_uv,
+                    np.asarray(faces, np.int64).reshape(-1, 3), np.asarray(face_material, np.int64), materials)
+
+
+def _material_slot(names: list[str], name: str) -> int:
+    if name not in names:
+        names.append(name)
+    return names.index(name)
+
+
+def _read_mtl(zf: zipfile.ZipFile, path: str, base: PurePosixPath) -> dict[str, dict]:
+    out: dict[str, dict] = {}
+    current: dict | None = None
+    for raw in zf.read(path).decode("latin-1").splitlines():
+        parts = raw.split()
+        if not parts:
+            continue
+        tag = parts[0]
+        if tag == "newmtl":
+            name = " ".join(parts[1:])
+            current = out[name] = {"name": name, "Kd": (0.7, 0.7, 0.7), "Ns": 10.0, "d": 1.0, "map_Kd": None}
+        elif current is None:
+            continue
+        elif tag == "Kd" and len(parts) >= 4:
+            current["Kd"] = tuple(float(p) for p in parts[1:4])
+        elif tag == "Ns":
+            current["Ns"] = float(parts[1])
+        elif tag == "d":
+            current["d"] = float(parts[1])
+        elif tag == "Tr":
+            current["d"] = 1.0 - float(parts[1])
+        elif tag == "map_Kd":
+            texture = str(base / parts[-1])
+            current["map_Kd"] = zf.read(texture) if texture in zf.namelist() else None
+    return out
+
+
+# --- turning a catalogue model into a library model ---------------------------------------------
+
+@dataclass
+class Converted:
+    """A model in our frame, ready to write."""
+    mesh: trimesh.Trimesh
+    uvs: np.ndarray
+    face_material: np.ndarray
+    materials: list[LibraryMaterial]
+    textures: dict[str, bytes]           # file name -> JPEG bytes
+
+
+def convert(entry: Entry, zf: zipfile.ZipFile) -> Converted:
+    """Read, orient, scale, simplify and texture one catalogue model."""
+    obj = read_obj(zf, entry.model)
+    keep_material = np.array([m["d"] > DROPPED_OPACITY for m in obj.materials], bool)
+    keep = keep_material[obj.face_material]
+    faces, face_material = obj.faces[keep], obj.face_material[keep]
+    vertices = obj.vertices
+    if entry.rotation is not None:
+        vertices = vertices @ np.asarray(entry.rotation).reshape(3, 3).T
+    # Sweet Home 3D: x = width, y = up, z = depth with the front towards +z.
+    # Ours: x = front (their +z), y = their x, z = up (their y): a proper rotation (a cyclic swap).
+    vertices = vertices[:, [2, 0, 1]]
+    lo, hi = vertices[faces].reshape(-1, 3).min(axis=0), vertices[faces].reshape(-1, 3).max(axis=0)
+    width, depth, height = entry.size_cm
+    target = np.array([depth, width, height]) / 100.0
+    vertices = (vertices - (lo + hi) / 2) * (target / np.maximum(hi - lo, 1e-9))
+    budget = int(np.clip(TRIANGLE_BUDGET * target.max() / 1.5, MIN_TRIANGLES, TRIANGLE_BUDGET))
+    mesh, uvs, face_material = _simplify(vertices, obj.uvs, faces, face_material, budget)
+    materials, textures = _materials(obj.materials, np.unique(face_material))
+    remap = {old: new for new, old in enumerate(np.unique(face_material))}
+    return Converted(mesh, uvs, np.array([remap[m] for m in face_material], np.uint8), materials, textures)
+
+
+def _simplify(vertices: np.ndarray, uvs: np.ndarray, faces: np.ndarray, face_material: np.ndarray,
+              budget: int) -> tuple[trimesh.Trimesh, np.ndarray, np.ndarray]:
+    """Each material's triangles simplified to its share of the budget (quadric decimation keeps the
+    silhouette); a kept vertex takes the texture coordinate of an original vertex it absorbed."""
+    import fast_simplification  # the maintainer's tool's own dependency
+    total = len(faces)
+    chunks = []
+    for material in np.unique(face_material):
+        sub = faces[face_material == material]
+        used, local = np.unique(sub, return_inverse=True)
+        points, tris, uv = vertices[used], local.reshape(-1, 3), uvs[used]
+        share = max(12, int(budget * len(sub) / max(total, 1)))
+        if len(tris) > share and len(tris) > 24:
+            points, tris, collapses = fast_simplification.simplify(
+                points.astype(np.float32), tris.astype(np.int32), 1.0 - share / len(tris), return_collapses=True)
+            _, _, mapping = fast_simplification.replay_simplification(
+                vertices[used].astype(np.float32), local.reshape(-1, 3).astype(np.int32), collapses)
+            new_uv = np.zeros((len(points), 2))
+            new_uv[mapping[::-1]] = uv[::-1]              # some original vertex of each kept one
+            uv = new_uv
+        chunks.append((np.asarray(points, np.float64), np.asarray(tris, np.int64), uv, material))
+    offsets = np.cumsum([0] + [len(c[0]) for c in chunks[:-1]])
+    mesh = trimesh.Trimesh(np.concatenate([c[0] for c in chunks]),
+                           np.concatenate([c[1] + o for c, o in zip(chunks, offsets)]), process=False)
+    uv_all = np.concatenate([c[2] for c in chunks])
+    material_all = np.concatenate([np.full(len(c[1]), c[3]) for c in chunks])
+    valid = mesh.nondegenerate_faces()
+    mesh.update_faces(valid)
+    return mesh, uv_all, material_all[valid]
+
+
+def _materials(mtl: Sequence[dict], used: np.ndarray) -> tuple[list[LibraryMaterial], dict[str, bytes]]:
+    materials, textures = [], {}
+    for index in used:
+        m = mtl[int(index)]
+        texture = None
+        if m["map_Kd"] is not None:
+            jpeg = _small_jpeg(m["map_Kd"])
+            if jpeg is not None:
+                texture = f"textures/{hashlib.sha1(jpeg).hexdigest()[:16]}.jpg"
+                textures[texture] = jpeg
+        kd = tuple(float(np.clip(c, 0.0, 1.0)) for c in m["Kd"])
+        roughness = float(np.clip(np.sqrt(2.0 / (max(m["Ns"], 0.0) + 2.0)), 0.05, 1.0))
+        kind = material_kind(m["name"], texture is not None, float(m["d"]))
+        materials.append(LibraryMaterial(name=m["name"], colour=kd, texture=texture, roughness=roughness,  # type: ignore[arg-type]
+                                         kind=kind))
+    return materials, textures
+
+
+def _small_jpeg(data: bytes) -> bytes | None:
+    image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+    if image is None:
+        return None
+    scale = TEXTURE_TEXELS / max(image.shape[:2])
+    if scale < 1:
+        image = cv2.resize(image, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
+    ok, jpeg = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, 85])
+    return jpeg.tobytes() if ok else None
+
+
+# --- choosing and writing ----------------------------------------------------------------------
+
+def choose(entries: Sequence[Entry], rules: dict[str, Rule] = RULES,
+           per_kind: int = MAX_PER_TYPE) -> dict[str, list[Entry]]:
+    """Per object kind, the catalogue entries whose name and category match its rule, in catalogue
+    order, at most ``per_kind``."""
+    out: dict[str, list[Entry]] = {}
+    for kind, rule in rules.items():
+        out[kind] = [e for e in entries if not e.door_or_window and e.category in rule.categories
+                     and re.search(rule.name, e.name.lower()) and not re.search(rule.exclude, e.name.lower())
+                     ][:per_kind]
+    return out
+
+
+def import_furniture(archives: Sequence[Path], out: Path, rules: dict[str, Rule] = RULES,
+                     per_kind: int = MAX_PER_TYPE, progress: bool = True) -> dict[str, list[str]]:
+    """Import the chosen models of ``archives`` into ``out`` (replacing it); returns kind -> model ids."""
+    entries = [e for archive in archives for e in catalogue_entries(Path(archive))]
+    chosen = choose(entries, rules, per_kind)
+    if out.exists():
+        shutil.rmtree(out)
+    (out / "models").mkdir(parents=True)
+    (out / "textures").mkdir()
+    records, written = [], {}
+    archives_open = {a: zipfile.ZipFile(a) for a in {e.archive for es in chosen.values() for e in es}}
+    try:
+        for kind, picked in chosen.items():
+            written[kind] = []
+            for entry in picked:
+                converted = convert(entry, archives_open[entry.archive])
+                model_id = _model_id(kind, entry)
+                _write_model(out / "models" / f"{model_id}.npz", converted)
+                for name, data in converted.textures.items():
+                    (out / name).write_bytes(data)
+                records.append(_record(model_id, kind, entry, converted))
+                written[kind].append(model_id)
+                if progress:
+                    print(f"{kind:28s} {model_id:40s} {len(converted.mesh.faces):5d} triangles  {entry.name}")
+    finally:
+        for zf in archives_open.values():
+            zf.close()
+    (out / "catalog.json").write_text(json.dumps({"format": CATALOG_FORMAT, "models": records}, indent=1) + "\n")
+    (out / "ATTRIBUTION.md").write_text(attribution(records))
+    return written
+
+
+def _model_id(kind: str, entry: Entry) -> str:
+    slug = re.sub(r"[^a-z0-9]+", "_", f"{entry.catalogue}_{entry.id.split('#')[-1]}".lower()).strip("_")
+    return f"{kind.replace('/', '_').lower()}__{slug}"
+
+
+def _write_model(path: Path, converted: Converted) -> None:
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, vertices=converted.mesh.vertices.astype(np.float32),
+                        faces=converted.mesh.faces.astype(np.uint32), uvs=converted.uvs.astype(np.float32),
+                        face_material=converted.face_material.astype(np.uint8))
+    path.write_bytes(buffer.getvalue())
+
+
+def _record(model_id: str, kind: str, entry: Entry, converted: Converted) -> dict:
+    return {"id": model_id, "kind": kind, "name": entry.name, "catalogue": entry.catalogue,
+            "catalogue_id": entry.id, "creator": entry.creator, "licence": entry.licence,
+            "size": [round(float(v), 4) for v in converted.mesh.extents],
+            "triangles": int(len(converted.mesh.faces)),
+            "materials": [m.model_dump() for m in converted.materials]}
+
+
+def attribution(records: Sequence[dict]) -> str:
+    """ATTRIBUTION.md: every shipped model with its creator, licence and source catalogue."""
+    lines = ["# Furniture models: attribution", "",
+             "Every model here comes from Sweet Home 3D's furniture catalogues (Debian packages",
+             "`sweethome3d-furniture` and `sweethome3d`), converted by `ravh import-furniture`",
+             "(simplified meshes, downsized textures). Each is shipped under the licence named below;",
+             "CC-BY models require this attribution to be kept.", "",
+             "| model file | name | creator | licence | catalogue (id) |", "| --- | --- | --- | --- | --- |"]
+    for r in records:
+        lines.append(f"| `models/{r['id']}.npz` | {r['name']} | {r['creator']} | {r['licence']} | "
+                     f"{r['catalogue']} ({r['catalogue_id']}) |")
+    return "\n".join(lines) + "\n"
+
+
+def iter_archives(paths: Sequence[Path]) -> Iterator[Path]:
+    """The catalogue archives among ``paths`` (files, or folders searched for .sh3f and .jar)."""
+    for path in paths:
+        if path.is_dir():
+            yield from sorted(p for p in path.rglob("*") if p.suffix in (".sh3f", ".jar"))
+        elif path.is_file():
+            yield path
+        else:
+            raise UserError(f"{path}: no such file or folder")

@@ -1,0 +1,191 @@
+"""The furniture library: modelled furniture from open catalogues, fitted into the houses' boxes.
+
+Format (``furniture/``, written by ``ravh import-furniture``, :mod:`ravh_sim.world.furniture_import`):
+
+- ``catalog.json``: ``{"format": CATALOG_FORMAT, "models": [...]}``; each model names its ``kind``
+  (our object type, or ``Type/class`` where a prefab class looks different: office chairs, coffee
+  tables, upper kitchen units), its source, creator and licence, its natural ``size`` (m, along
+  front, across, up) and its materials (:class:`LibraryMaterial`).
+- ``models/<id>.npz``: ``vertices`` (N, 3) float32 in metres, centred on the model's box, z up,
+  front along +x; ``faces`` (M, 3); ``uvs`` (N, 2); ``face_material`` (M,) into the materials.
+- ``textures/*.jpg``: base-colour textures, at most 256 texels a side.
+- ``ATTRIBUTION.md``: every model's creator and licence.
+
+A model is fitted into an object's box by :func:`fit`: scaled uniformly to fill the box as far as
+its proportions allow, then stretched by at most :data:`MAX_STRETCH` per axis towards the box, set
+on the box's floor and against its back; so it always lies inside the box the footprint records.
+"""
+from __future__ import annotations
+
+import functools
+import re
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+import trimesh
+from pydantic import Field
+
+from ravh_sim.paths import FURNITURE_DIR
+from ravh_sim.schema import Strict
+from ravh_sim.world.mesh import Mesh
+from ravh_sim.world.palette import PALETTE
+
+CATALOG_FORMAT = "ravh_sim/furniture@1"
+MAX_STRETCH = 1.3
+"""Largest per-axis stretch beyond a uniform scale: a sofa may grow a little wider, not turn into
+a bench."""
+
+_TEXTURE_STAND_IN = (0.6, 0.5, 0.4)          # a textured material's colour where textures are not drawn
+
+Kind = Literal["textured", "wood", "fabric", "leather", "metal", "glass", "mirror", "screen", "ceramic",
+               "marble", "plant", "emissive", "plain"]
+
+_KIND_WORDS: tuple[tuple[str, str], ...] = (
+    ("mirror", r"mirror|miroir"),
+    ("screen", r"screen|display|lcd|monitor|ecran"),
+    ("glass", r"glass|verre|crystal|transp"),
+    ("metal", r"chrom|metal|steel|inox|alumin|silver|iron|brass|gold|nickel|copper"),
+    ("leather", r"leather|cuir"),
+    ("fabric", r"fabric|cloth|cushion|textile|velvet|linen|cotton|tissu|sheet|pillow|mattress|blanket|curtain"),
+    ("wood", r"wood|bois|oak|pine|walnut|teak|beech|cherry|maple|mahogany|birch|parquet"),
+    ("marble", r"marble|granit|stone"),
+    ("ceramic", r"ceramic|porcelain|enamel|faience|email"),
+    ("plant", r"leaf|leaves|plant|foliage|grass|flower"),
+    ("emissive", r"bulb|lamp_?light|emissi|neon"),
+)
+
+
+def material_kind(name: str, textured: bool, opacity: float) -> str:
+    """What an MTL material is made of, from its name (textured ones keep their texture)."""
+    if textured:
+        return "textured"
+    lowered = name.lower()
+    if opacity < 0.9:
+        return "glass"
+    for kind, pattern in _KIND_WORDS:
+        if re.search(pattern, lowered):
+            return kind
+    return "plain"
+
+
+class LibraryMaterial(Strict):
+    """One material of a library model: MTL diffuse colour (sRGB), texture, roughness (from Ns)."""
+    name: str
+    colour: tuple[float, float, float]
+    texture: str | None = None
+    roughness: float = Field(ge=0.0, le=1.0)
+    kind: Kind
+
+
+class LibraryRecord(Strict):
+    id: str
+    kind: str
+    name: str
+    catalogue: str
+    catalogue_id: str
+    creator: str
+    licence: str
+    size: tuple[float, float, float]
+    triangles: int
+    materials: list[LibraryMaterial]
+
+
+class LibraryCatalog(Strict):
+    format: Literal["ravh_sim/furniture@1"]
+    models: list[LibraryRecord]
+
+
+@dataclass(frozen=True)
+class LibraryModel:
+    """A library model's triangles in its own frame (centred box, z up, front along +x)."""
+    record: LibraryRecord
+    vertices: np.ndarray              # (N, 3) float64
+    faces: np.ndarray                 # (M, 3) int64
+    uvs: np.ndarray                   # (N, 2) float32
+    face_material: np.ndarray         # (M,) int64
+
+    @property
+    def id(self) -> str:
+        return self.record.id
+
+    @property
+    def materials(self) -> list[LibraryMaterial]:
+        return self.record.materials
+
+
+@dataclass(frozen=True)
+class FittedModel:
+    """A library model placed in an object's body frame (the box centred at the origin)."""
+    model: LibraryModel
+    vertices: np.ndarray              # (N, 3) in the body frame
+
+    @property
+    def mesh(self) -> trimesh.Trimesh:
+        return trimesh.Trimesh(self.vertices, self.model.faces, process=False)
+
+
+_PREFAB_CLASSES: tuple[tuple[str, str, str], ...] = (
+    ("Chair", r"office", "office"),
+    ("Table", r"small", "small"),
+    ("Standard", r"tv", "tv"),
+    ("Decoration", r"vase", "vase"),
+    ("KitchenFurniture", r"corner up", "corner_upper"),
+    ("KitchenFurniture", r"corner", "corner"),
+    ("KitchenFurniture", r"up$", "upper"),
+    ("KitchenFurniture", r"sink", "sink"),
+    ("KitchenFurniture", r"burner|oven", "stove"),
+)
+
+
+def kind_of(object_type: str, prefab: str) -> str:
+    """The library kind of an object: its type, or ``Type/class`` for prefabs that look different."""
+    lowered = prefab.lower().strip()
+    for type_, pattern, cls in _PREFAB_CLASSES:
+        if object_type == type_ and re.search(pattern, lowered):
+            return f"{type_}/{cls}"
+    return object_type
+
+
+@functools.lru_cache(maxsize=1)
+def catalog() -> LibraryCatalog:
+    path = FURNITURE_DIR / "catalog.json"
+    if not path.exists():
+        return LibraryCatalog(format=CATALOG_FORMAT, models=[])
+    return LibraryCatalog.model_validate_json(path.read_text())
+
+
+@functools.lru_cache(maxsize=None)
+def models_of(kind: str) -> tuple[LibraryRecord, ...]:
+    """The library's models of a kind, in catalogue order (empty: the kind has none)."""
+    return tuple(r for r in catalog().models if r.kind == kind)
+
+
+@functools.lru_cache(maxsize=256)
+def load_model(model_id: str) -> LibraryModel:
+    record = next(r for r in catalog().models if r.id == model_id)
+    with np.load(FURNITURE_DIR / "models" / f"{model_id}.npz") as data:
+        return LibraryModel(record, data["vertices"].astype(np.float64), data["faces"].astype(np.int64),
+                            data["uvs"].astype(np.float32), data["face_material"].astype(np.int64))
+
+
+def fit(model: LibraryModel, size: np.ndarray) -> np.ndarray:
+    """The model's vertices scaled into a box of ``size`` (front, across, up) centred at the origin:
+    as large as its proportions allow, stretched by at most MAX_STRETCH per axis towards the box,
+    standing on the box's floor with its back against the box's back (x = -size/2)."""
+    natural = np.maximum(np.ptp(model.vertices, axis=0), 1e-6)
+    size = np.asarray(size, np.float64)
+    uniform = float(np.min(size / natural))
+    scale = uniform * np.minimum(size / (uniform * natural), MAX_STRETCH)
+    vertices = (model.vertices - model.vertices.min(axis=0)) * scale
+    extent = natural * scale
+    offset = np.array([-size[0] / 2, -extent[1] / 2, -size[2] / 2])
+    return vertices + offset
+
+
+def palette_stand_in(fitted: FittedModel) -> Mesh:
+    """The fitted model coloured with the nearest palette colour of each material: what pybullet's
+    TinyRenderer fallback draws (it knows one texture per body, not a model's textures)."""
+    srgb = np.array([m.colour if m.texture is None else _TEXTURE_STAND_IN for m in fitted.model.materials])
+    nearest = np.argmin(np.linalg.norm(PALETTE.rgb[None, :, :] - srgb[:, None, :], axis=2), axis=1)
+    return Mesh(fitted.vertices, fitted.model.faces, nearest[fitted.model.face_material])
