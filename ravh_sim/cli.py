@@ -183,9 +183,12 @@ def cmd_render(args: argparse.Namespace) -> int:
 
 
 def cmd_gallery(args: argparse.Namespace) -> int:
-    from ravh_sim.viz.gallery import gallery
+    from ravh_sim.viz.gallery import gallery, object_gallery
     pose = tuple(args.pose) if args.pose else None
-    print(f"wrote {gallery(args.house, args.output, args.seed, pose, args.renderer)}")
+    if args.objects:
+        print(f"wrote {object_gallery(args.house, args.output, args.seed, args.renderer)}")
+    else:
+        print(f"wrote {gallery(args.house, args.output, args.seed, pose, args.renderer)}")
     return 0
 
 
@@ -298,6 +301,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--pose", type=float, nargs=3, metavar=("X", "Y", "YAW"), default=None,
                    help="robot pose (default: the room-centre view with the most objects)")
+    p.add_argument("--objects", action="store_true",
+                   help="instead: sofas, beds, tables, chairs, fridges, ovens, toilets... each from the front, "
+                        "by day and at night")
     p.add_argument("--renderer", choices=BACKENDS, default="auto")
     p.add_argument("-o", "--output", type=Path, required=True, help="PNG file")
     p.set_defaults(func=cmd_gallery)

@@ -95,3 +95,68 @@ def _labelled(rgb: np.ndarray, text: str) -> np.ndarray:
     strip = np.full((LABEL_PX, rgb.shape[1], 3), 24, np.uint8)
     cv2.putText(strip, text, (8, LABEL_PX - 10), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (235, 235, 235), 1, cv2.LINE_AA)
     return np.vstack([rgb, strip])
+
+
+SHOWCASE_TYPES = ("Sofa", "Armchair", "Bed", "Table", "Chair", "Refrigerator", "Oven", "Toilet", "Tv",
+                  "Washbasin", "Desk", "Closet")
+"""The object types ``ravh gallery --objects`` shows: what a detector trained on photos must find."""
+VIEW_DISTANCES_M = (1.6, 2.2, 2.8)
+VIEW_OFFSETS_RAD = (0.0, -0.45, 0.45)
+OBJECT_VIEWS_PER_TYPE = 3         # objects of a type tried for a view
+
+
+def object_views(world: World, camera: SmartCamera, types: tuple[str, ...] = SHOWCASE_TYPES
+                 ) -> list[tuple[str, tuple[float, float, float]]]:
+    """Per type the house has, a robot pose that sees one of its objects from the front: among
+    poses 1.6-2.8 m in front of it, the one whose camera sees most of it (counted on ``camera``)."""
+    from ravh_sim.world.solids import object_parts
+    house = world.house
+    views = []
+    for object_type in types:
+        best, best_pixels = None, 0
+        for obj in [o for o in house.objects if o.type == object_type][:OBJECT_VIEWS_PER_TYPE]:
+            placed = object_parts(house, obj, world.state.models[obj.id])
+            front = placed.yaw if placed.front is None else placed.front
+            x0, y0 = placed.position[:2]
+            instance = world.instance(obj.id).id
+            for distance in VIEW_DISTANCES_M:
+                for offset in VIEW_OFFSETS_RAD:
+                    heading = front + offset
+                    x, y = x0 + distance * math.cos(heading), y0 + distance * math.sin(heading)
+                    room = house.room_at(x, y)
+                    if room is None:
+                        continue
+                    pose = (x, y, heading + math.pi)
+                    pixels = int((camera.capture(*pose, floor_z=room.floor_z).instance == instance).sum())
+                    if pixels > best_pixels:
+                        best, best_pixels = pose, pixels
+        if best is not None:
+            views.append((object_type, best))
+    return views
+
+
+def object_gallery(house_number: int, output: Path, seed: int = 0, renderer: str = "auto") -> Path:
+    """Write a sheet of the showcase types of a house, each seen from the front by day (raid 0's
+    look) and at night with the lights on (raid 4's), side by side."""
+    house = load_house(house_number)
+    profile = load_profile()
+    with World(house, _preset(house, 0, seed), renderer=renderer) as world:
+        appearance = Appearance(world)
+        scout = SmartCamera(world, replace(profile.camera, quality="fast"))
+        views = object_views(world, scout)
+        scout.close()
+        camera = SmartCamera(world, profile.camera)
+        panels: dict[str, list[np.ndarray]] = {name: [] for name, _ in views}
+        for raid, look in ((0, "day"), (4, "night")):
+            appearance.apply(_preset(house, raid, seed))
+            for name, pose in views:
+                panels[name].append(_labelled(camera.capture(*pose).rgb, f"{name}, {look}"))
+        camera.close()
+    pairs = [np.hstack(p) for p in panels.values()]
+    rows = [np.hstack(pairs[k:k + 2]) if k + 1 < len(pairs) else np.hstack([pairs[k], np.zeros_like(pairs[k])])
+            for k in range(0, len(pairs), 2)]
+    sheet = cv2.resize(np.vstack(rows), None, fx=0.5, fy=0.5, interpolation=cv2.INTER_AREA)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    if not cv2.imwrite(str(output), cv2.cvtColor(sheet, cv2.COLOR_RGB2BGR)):
+        raise OSError(f"could not write {output}")
+    return output

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ravh_sim.world.facing import choose_facing
+from ravh_sim.world.facing import choose_facing, suits_box
 import trimesh
 
 from ravh_sim.world import library
@@ -50,6 +50,7 @@ class Placed:
     position: tuple[float, float, float]
     yaw: float
     model: library.FittedModel | None = None
+    front: float | None = None             # heading of a library model's front in the house frame
 
     def mesh(self) -> Mesh:
         """The procedural parts merged: what the camera draws of them."""
@@ -89,8 +90,10 @@ def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
     variant = obj.default_model if model is None else model
     records = library.models_of(library.kind_of(obj.type, obj.prefab))
     if records:
+        if not suits_box(front_axis(obj.type), np.asarray(box.size), facing):
+            facing = (facing + 1) % 4
         fitted, bounds = _fitted(records[variant % len(records)].id, tuple(box.size), facing)
-        return Placed((), bounds, box.position, obj.yaw, fitted)
+        return Placed((), bounds, box.position, obj.yaw, fitted, obj.yaw + facing * math.pi / 2)
     parts, bounds = _parts(obj.type, tuple(box.size), variant, facing, obj.prefab)
     return Placed(parts, bounds, box.position, obj.yaw)
 
