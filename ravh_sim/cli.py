@@ -22,7 +22,7 @@ from ravh_sim.dataset.build import add_parser as add_dataset_parser
 from ravh_sim.errors import UserError
 from ravh_sim.nodes.launch import NODES
 from ravh_sim.nodes.launch import main as launch_node
-from ravh_sim.paths import HOUSES_DIR
+from ravh_sim.paths import FURNITURE_DIR, HOUSES_DIR
 from ravh_sim.render.backend import BACKENDS
 
 Command = Callable[[argparse.Namespace], int]
@@ -78,6 +78,17 @@ def cmd_import_houses(args: argparse.Namespace) -> int:
     from ravh_sim.world.importer import import_houses
     written = import_houses(args.src, args.out)
     print(f"imported {len(written)} houses into {args.out}")
+    return 0
+
+
+def cmd_import_furniture(args: argparse.Namespace) -> int:
+    from ravh_sim.world.furniture_import import import_furniture, iter_archives
+    archives = list(iter_archives(args.src))
+    if not archives:
+        raise UserError("no .sh3f or .jar furniture catalogue among " + ", ".join(map(str, args.src)))
+    written = import_furniture(archives, args.out, progress=not args.quiet)
+    print(f"imported {sum(map(len, written.values()))} models of {sum(1 for v in written.values() if v)} kinds "
+          f"into {args.out}")
     return 0
 
 
@@ -249,6 +260,14 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("src", type=Path, help="folder with the upstream houseNN.json files")
     p.add_argument("-o", "--out", type=Path, default=HOUSES_DIR, help="output folder (default: houses/)")
     p.set_defaults(func=cmd_import_houses)
+
+    p = sub.add_parser("import-furniture",
+                       help="convert Sweet Home 3D furniture catalogues into the furniture library (maintainers)")
+    p.add_argument("src", type=Path, nargs="+",
+                   help=".sh3f/.jar catalogues or folders holding them (Debian: sweethome3d-furniture, sweethome3d)")
+    p.add_argument("-o", "--out", type=Path, default=FURNITURE_DIR, help="output folder (default: furniture/)")
+    p.add_argument("-q", "--quiet", action="store_true", help="no line per model")
+    p.set_defaults(func=cmd_import_furniture)
 
     p = sub.add_parser("houses", help="list the houses with room and object counts")
     p.add_argument("--json", action="store_true", help="machine-readable output")

@@ -1,4 +1,5 @@
-"""Tests for the procedural furniture library: meshes, palette, models and facing."""
+"""Tests for the procedural models (what the furniture library has no model of): meshes, palette,
+models and facing."""
 from __future__ import annotations
 
 import itertools
@@ -7,40 +8,24 @@ import cv2
 import numpy as np
 import pytest
 
-from ravh_sim.world.facing import choose_facing, side_distances, suits_box
-from ravh_sim.world.furniture import OBJECT_TYPES, build_model, front_axis, variant_count
+from ravh_sim.world.facing import choose_facing, front_axis, side_distances, suits_box
+from ravh_sim.world.furniture import OBJECT_TYPES, build_model, variant_count
 from ravh_sim.world.mesh import Mesh, box, cylinder, ellipsoid, frustum, rotation_y, rotation_z, rounded_box
 from ravh_sim.world.palette import PALETTE, Palette
 
 # Upstream Robot@VirtualHome model counts per type (from the house data).
 UPSTREAM_MODELS = {
-    'Armchair': 4, 'Bathtub': 1, 'Bed': 5, 'Brush': 1, 'Burner': 1, 'Cabinet': 4, 'Chair': 4, 'Closet': 4,
-    'Counter': 4, 'Cup': 1, 'Decoration': 3, 'Desk': 2, 'Dishwasher': 1, 'Door': 3, 'Dresser': 2, 'Drying': 3,
-    'Keyboard': 1, 'KitchenFurniture': 4, 'Lamp': 4, 'Laptop': 2, 'Light': 2, 'Lighter': 1, 'Microwave': 1,
-    'Mirror': 2, 'Nightstand': 3, 'Oven': 1, 'Picture': 4, 'Pouf': 4, 'Refrigerator': 2, 'Shelf': 3,
-    'ShowerCabin': 1, 'Sink': 2, 'Sofa': 4, 'Standard': 4, 'Station': 1, 'Stool': 4, 'Table': 4, 'Toilet': 1,
-    'Toothbrush': 1, 'Towel': 4, 'Tv': 2, 'Wall': 3, 'Washbasin': 2, 'WashingMachine': 1,
+    'Counter': 4, 'Door': 3, 'Keyboard': 1, 'Lighter': 1, 'Mirror': 2, 'Picture': 4, 'Pouf': 4, 'Station': 1,
+    'Toothbrush': 1, 'Wall': 3,
 }
 
 # Typical upstream box sizes (sx, sy, sz) in metres; other types use a generic 0.6 m box.
 TYPICAL = {
-    'Armchair': (0.77, 0.76, 0.62), 'Bed': (1.1, 2.21, 1.03), 'Chair': (0.53, 0.42, 1.01),
-    'Closet': (1.75, 0.66, 2.02), 'Counter': (0.6, 0.58, 0.04), 'Desk': (0.68, 1.47, 0.75),
-    'Door': (0.26, 0.94, 2.5), 'Dresser': (0.9, 0.32, 0.5), 'Drying': (0.1, 0.53, 0.62),
-    'KitchenFurniture': (0.57, 0.71, 0.83), 'Lamp': (0.37, 0.17, 0.38), 'Mirror': (0.68, 0.04, 1.05),
-    'Picture': (0.68, 0.04, 0.48), 'Sofa': (1.98, 0.97, 0.65), 'Standard': (0.39, 0.79, 1.49),
-    'Table': (0.79, 0.72, 0.5), 'Toilet': (0.76, 0.48, 0.95), 'Tv': (0.92, 0.18, 0.62),
-    'Wall': (1.36, 0.17, 1.36), 'Washbasin': (0.58, 0.91, 1.26), 'Cup': (0.07, 0.08, 0.12),
-    'Light': (0.36, 0.36, 0.08), 'Station': (0.5, 0.5, 0.02), 'Shelf': (0.67, 0.24, 0.04),
-    'Burner': (0.58, 0.64, 0.06), 'Keyboard': (0.44, 0.14, 0.03), 'Toothbrush': (0.06, 0.11, 0.2),
+    'Counter': (0.6, 0.58, 0.04), 'Door': (0.26, 0.94, 2.5), 'Mirror': (0.68, 0.04, 1.05),
+    'Picture': (0.68, 0.04, 0.48), 'Wall': (1.36, 0.17, 1.36), 'Station': (0.5, 0.5, 0.02),
+    'Keyboard': (0.44, 0.14, 0.03), 'Toothbrush': (0.06, 0.11, 0.2), 'Pouf': (0.5, 0.5, 0.4),
 }
 
-PREFABS = {
-    'KitchenFurniture': ['', '1 Door', '2Door', '3 Door', '1 Door Up', '2 Door Up', '3 Door Up', 'Corner',
-                         'Corner Up', 'Sink/Body', 'Sink2/Body', 'Burner and Oven'],
-    'Standard': ['rack_1', 'Tv Table'], 'Sofa': ['Small Sofa', 'Corner Sofa'],
-    'Chair': ['Chair', 'Chair_office'], 'Bathtub': ['Bathtub', 'Bathtub 2'],
-}
 
 ALL_TYPES = list(OBJECT_TYPES) + ['SomethingUnknown']
 
@@ -70,19 +55,17 @@ def check_model(mesh: Mesh, size: tuple[float, float, float]) -> None:
 
 @pytest.mark.parametrize('object_type', ALL_TYPES)
 def test_models_fit_their_box_for_every_variant_size_and_facing(object_type):
-    for prefab in PREFABS.get(object_type, ['']):
-        variants = range(variant_count(object_type))
-        for variant, size, facing in itertools.product(variants, sizes_for(object_type), range(4)):
-            mesh = build_model(object_type, size, variant, facing, prefab)
-            check_model(mesh, size)
-            assert mesh.triangle_count <= 500
+    variants = range(variant_count(object_type))
+    for variant, size, facing in itertools.product(variants, sizes_for(object_type), range(4)):
+        mesh = build_model(object_type, size, variant, facing)
+        check_model(mesh, size)
+        assert mesh.triangle_count <= 500
 
 
 @pytest.mark.parametrize('object_type', ALL_TYPES)
 def test_typical_models_stay_within_triangle_budget(object_type):
-    for prefab in PREFABS.get(object_type, ['']):
-        for variant in range(variant_count(object_type)):
-            assert build_model(object_type, typical(object_type), variant, 0, prefab).triangle_count <= 400
+    for variant in range(variant_count(object_type)):
+        assert build_model(object_type, typical(object_type), variant, 0).triangle_count <= 400
 
 
 def test_average_model_is_cheap():
@@ -106,19 +89,17 @@ def same_mesh(a: Mesh, b: Mesh) -> bool:
 
 @pytest.mark.parametrize('object_type', [t for t in OBJECT_TYPES if variant_count(t) > 1])
 def test_variants_differ(object_type):
-    for prefab in PREFABS.get(object_type, ['']):
-        meshes = [build_model(object_type, typical(object_type), v, 0, prefab)
-                  for v in range(variant_count(object_type))]
-        for a, b in itertools.combinations(range(len(meshes)), 2):
-            assert not same_mesh(meshes[a], meshes[b]), f'{object_type} {prefab!r}: {a} and {b} look alike'
+    meshes = [build_model(object_type, typical(object_type), v, 0) for v in range(variant_count(object_type))]
+    for a, b in itertools.combinations(range(len(meshes)), 2):
+        assert not same_mesh(meshes[a], meshes[b]), f'{object_type}: {a} and {b} look alike'
 
 
 def test_variant_index_wraps_and_facing_wraps():
-    assert same_mesh(build_model('Chair', (0.5, 0.5, 1.0), 5), build_model('Chair', (0.5, 0.5, 1.0), 1))
-    assert same_mesh(build_model('Chair', (0.5, 0.5, 1.0), 0, 6), build_model('Chair', (0.5, 0.5, 1.0), 0, 2))
+    assert same_mesh(build_model('Pouf', (0.5, 0.5, 0.4), 5), build_model('Pouf', (0.5, 0.5, 0.4), 1))
+    assert same_mesh(build_model('Pouf', (0.5, 0.5, 0.4), 0, 6), build_model('Pouf', (0.5, 0.5, 0.4), 0, 2))
 
 
-@pytest.mark.parametrize('object_type', ['Bed', 'KitchenFurniture', 'Picture', 'Lamp'])
+@pytest.mark.parametrize('object_type', ['Door', 'Counter', 'Picture', 'Wall'])
 def test_models_are_deterministic(object_type, tmp_path):
     a = build_model(object_type, typical(object_type), 1, 3)
     b = build_model(object_type, typical(object_type), 1, 3)
@@ -131,48 +112,8 @@ def test_models_are_deterministic(object_type, tmp_path):
 
 def test_bad_sizes_still_give_a_model():
     for size in [(0.0, 0.5, 0.5), (-0.4, 0.5, 0.5), (float('nan'), 0.5, 0.5)]:
-        mesh = build_model('Chair', size, 0)
+        mesh = build_model('Picture', size, 0)
         assert np.isfinite(mesh.vertices).all() and mesh.face_areas().min() > 0
-
-
-FACING_DIRECTIONS = np.array([(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)])
-
-
-def centroid_of(mesh: Mesh, mask: np.ndarray) -> np.ndarray:
-    return mesh.vertices[np.unique(mesh.faces[mask])].mean(axis=0)
-
-
-@pytest.mark.parametrize('facing', range(4))
-def test_chair_back_is_opposite_its_facing(facing):
-    size = (0.5, 0.5, 1.0)
-    mesh = build_model('Chair', size, 0, facing)
-    top = mesh.vertices[:, 2] > 0.3  # only the chair back rises this high
-    back = mesh.vertices[top, :2].mean(axis=0)
-    assert np.dot(back, FACING_DIRECTIONS[facing]) < -0.1
-
-
-@pytest.mark.parametrize('facing', range(4))
-@pytest.mark.parametrize('size', [(1.1, 2.2, 1.0), (2.2, 1.1, 1.0)])
-def test_bed_headboard_is_at_an_end_of_the_long_axis(size, facing):
-    mesh = build_model('Bed', size, 0, facing)
-    top = mesh.vertices[mesh.vertices[:, 2] > 0.45, :2].mean(axis=0)  # only the headboard is that tall
-    long_axis = int(np.argmax(size[:2]))
-    assert abs(top[long_axis]) > 0.4 * size[long_axis]
-    if facing % 2 == long_axis:  # facing agrees with the box: headboard on the back end
-        assert np.dot(top, FACING_DIRECTIONS[facing]) < 0
-
-
-@pytest.mark.parametrize('facing', range(4))
-def test_tv_screen_looks_along_its_facing(facing):
-    size = (0.9, 0.2, 0.6) if facing % 2 else (0.2, 0.9, 0.6)
-    mesh = build_model('Tv', size, 0, facing)
-    screen = mesh.colours == PALETTE.index('screen')
-    bezel = mesh.colours == PALETTE.index('charcoal')
-    direction = FACING_DIRECTIONS[facing]
-    cross = mesh.face_cross()[screen]
-    normal = cross[np.argmax(np.linalg.norm(cross, axis=1))]
-    assert abs(np.dot(normal[:2], direction)) / np.linalg.norm(normal) > 0.99  # the panel faces that way
-    assert np.dot(centroid_of(mesh, screen)[:2] - centroid_of(mesh, bezel)[:2], direction) > 0  # and in front
 
 
 @pytest.mark.parametrize('object_type', OBJECT_TYPES)

@@ -11,10 +11,8 @@ from conftest import resolved
 
 from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import build_instances, make_footprint
-from ravh_sim.world.furniture import variant_count
-from ravh_sim.world.mesh import Mesh
 from ravh_sim.world.scene import World
-from ravh_sim.world.solids import object_parts
+from ravh_sim.world.solids import model_count, object_parts
 
 
 def test_every_house_builds_with_one_body_per_labelled_object(houses):
@@ -31,7 +29,7 @@ def test_every_house_builds_with_one_body_per_labelled_object(houses):
 
 def test_house_23_geometry_budget(houses):
     with World(houses[23], resolved(houses[23]), renderer="tiny") as world:
-        assert 0 < world.triangle_count < 60_000
+        assert 0 < world.triangle_count < 200_000
 
 
 def test_instances_match_the_pure_instance_table(houses):
@@ -43,14 +41,18 @@ def test_instances_match_the_pure_instance_table(houses):
 def test_collision_boxes_fit_the_object_boxes(houses):
     house = houses[20]
     settings = resolved(house)
+    filled = []
     with World(house, settings, renderer="tiny") as world:
         for obj in house.objects:
             if obj.type in ("Door", "Station"):
                 continue
             box = obj.box(settings.models[obj.id])
             lo, hi = pb.getAABB(world.instance(obj.id).body, physicsClientId=world.client)
-            assert (lo[2] + hi[2]) / 2 == pytest.approx(box.position[2], abs=0.02), obj.id
-            assert hi[2] - lo[2] == pytest.approx(box.size[2], abs=0.02), obj.id
+            bottom, top = box.position[2] - box.size[2] / 2, box.position[2] + box.size[2] / 2
+            assert lo[2] == pytest.approx(bottom, abs=0.02), obj.id        # on the box's floor
+            assert hi[2] <= top + 0.02, obj.id                             # inside it
+            filled.append((hi[2] - lo[2]) / box.size[2])
+    assert np.median(filled) > 0.95                                        # library models fill heights
 
 
 def test_doors_open_and_close_at_run_time(houses):
@@ -96,14 +98,14 @@ def test_every_variant_of_every_object_lies_in_its_footprint_box(houses):
     checked = 0
     for n, house in houses.items():
         settings = resolved(house)
-        for variant in range(max(variant_count(o.type) for o in house.objects)):
+        for variant in range(max(model_count(o) for o in house.objects)):
             models = {o.id: variant for o in house.objects}
             rows = {r["name"]: r for r in make_footprint(house, replace(settings, models=models))["instances"]}
             for obj in house.objects:
                 row, placed = rows[obj.id], object_parts(house, obj, variant)
                 if obj.id in house.door_by_id:
                     continue                        # the leaf in the doorway, not an upstream box
-                lo, hi = Mesh.merged(placed.parts).bounds()
+                lo, hi = placed.extent()
                 assert placed.position == pytest.approx(row["position"], abs=1e-4), (n, obj.id, variant)
                 assert placed.yaw == pytest.approx(row["yaw"], abs=1e-4), (n, obj.id, variant)
                 half = np.asarray(row["size"]) / 2 + 1e-4

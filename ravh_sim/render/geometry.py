@@ -3,8 +3,9 @@
 Every triangle corner carries its house-frame position, a shading normal, its position in the body's
 own frame (procedural patterns are evaluated there, so a wood grain moves with its table and does
 not swim when a door swings), a material index (ravh_sim.render.materials), the instance id that
-instance images store and a texture coordinate (library models' textures; zero elsewhere). Normals come from trimesh: smooth across gentle bends (cushions, bowls,
-lamp shades), flat across creases (box edges), decided per corner by a crease angle.
+instance images store and a texture coordinate (library models' textures; zero elsewhere). Normals
+come from trimesh: smooth across gentle bends (cushions, bowls, lamp shades), flat across creases
+(box edges), decided per corner by a crease angle.
 """
 from __future__ import annotations
 

@@ -31,6 +31,7 @@ PATTERNS = ("plain", "plaster", "wood", "parquet", "tiles", "marble", "fabric", 
 PATTERN = {name: i for i, name in enumerate(PATTERNS)}
 TEXELS = 4                                   # texels per material row (see pack)
 LIBRARY_TEXELS = 256                         # side of every library texture in the texture array
+METAL_REFLECTANCE = 0.6                      # linear reflectance of a library model's steel and chrome
 
 
 @dataclass(frozen=True)
@@ -169,6 +170,10 @@ def library_material(material: LibraryMaterial, layer: int) -> Material:
     if material.kind == "glass":
         return Material(_scaled(colour, 0.3), "ceramic", 0.05, variation=0.0)
     family = palette_material(_LIBRARY_FAMILY[material.kind], material.colour)
+    if material.kind == "metal":          # MTL greys of steel are dark; polished steel reflects ~60 %
+        lightest = max(family.colour)
+        return replace(family, colour=_scaled(family.colour, max(1.0, METAL_REFLECTANCE / max(lightest, 1e-3))),
+                       roughness=max(family.roughness, 0.4))
     roughness = family.roughness if material.kind != "plain" else material.roughness
     return replace(family, roughness=roughness)
 

@@ -24,9 +24,9 @@ from ravh_msgs_py.appearance import LIGHT_GROUPS, SUN_PRESETS, SURFACES, SWITCH
 from ravh_msgs_py.query import UNKNOWN_ID, QueryError
 from ravh_sim.errors import UnknownNameError, UserError
 from ravh_sim.world import paints
-from ravh_sim.world.solids import model_count
 from ravh_sim.world.scene import World
 from ravh_sim.world.settings import Resolved, light_group, load_settings, resolve
+from ravh_sim.world.solids import model_count
 
 RGB = tuple[float, float, float]
 

@@ -27,6 +27,21 @@ SWAP_RATIO = 1.15
 """How much longer than the other a box axis must be before 'short'/'long' fronts care."""
 
 
+SHORT_FRONT = frozenset({
+    'Bathtub', 'Cabinet', 'Closet', 'Desk', 'Door', 'Dresser', 'Drying', 'Keyboard', 'Laptop', 'Lighter',
+    'Microwave', 'Mirror', 'Picture', 'Shelf', 'Sofa', 'Standard', 'Towel', 'Tv', 'Wall', 'Washbasin'})
+LONG_FRONT = frozenset({'Bed', 'Toilet'})
+
+
+def front_axis(object_type: str) -> str:
+    """Which box side a type's front belongs on: 'short', 'long' or 'any' (see :func:`suits_box`).
+
+    Pass it to :func:`choose_facing` so that, say, a wardrobe in a corner backs onto the wall
+    behind its long side.
+    """
+    return 'short' if object_type in SHORT_FRONT else 'long' if object_type in LONG_FRONT else 'any'
+
+
 def suits_box(front: str, size: Sequence[float] | np.ndarray, facing: int) -> bool:
     """Whether ``facing`` suits a type whose front belongs on a given side of its box.
 

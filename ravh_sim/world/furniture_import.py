@@ -30,14 +30,21 @@ import numpy as np
 import trimesh
 
 from ravh_sim.errors import UserError
-from ravh_sim.world.library import CATALOG_FORMAT, LibraryMaterial, material_kind
+from ravh_sim.world.library import CATALOG_FORMAT, LibraryMaterial, material_kind, piece_labels
 
-TRIANGLE_BUDGET = 4000
+TRIANGLE_BUDGET = 2000
 """Triangles of a model 1.5 m or larger after simplification (smaller ones get a share in proportion
-to their size, at least MIN_TRIANGLES): a 640x480 frame shows a sofa over ~300 px, where 4k
-triangles already put several triangles per silhouette pixel; a house of ~100 objects then stays
-near 200k triangles, which the renderer's rebuild on a model change and llvmpipe handle."""
-MIN_TRIANGLES = 600
+to their size, at least MIN_TRIANGLES): a 640x480 frame shows a sofa over ~300 px, where 2k
+triangles already put a triangle on every few silhouette pixels; a house of ~100 objects then stays
+near 150k triangles, whose build (pybullet's triangle-mesh colliders) and GPU upload stay within
+the 2 s house build and the sim's memory budget (measured: 4k per model gave 260k triangles in
+house 23 and 830 MB peak; see the closing note of issue 19)."""
+MIN_TRIANGLES = 300
+OVER_BUDGET = 1.5
+ABSOLUTE_BUDGET = 3000
+"""A model that simplification cannot bring within OVER_BUDGET times its budget, nor under
+ABSOLUTE_BUDGET (thousands of loose pieces), is passed over for the kind's next match; a kind whose
+every match is over keeps its smallest."""
 TEXTURE_TEXELS = 256
 """Longest texture side: fabric, wood and labels tile or cover a few hundred pixels in a frame."""
 MAX_PER_TYPE = 4
@@ -58,7 +65,8 @@ class Rule:
 RULES: dict[str, Rule] = {
     "Armchair": Rule(r"armchair$|^armchair", exclude=r"ottoman|rattan|office"),
     "Bathtub": Rule(r"^bath$|bathtub|^fitted bath|^island bath"),
-    "Bed": Rule(r"^bed\b|^double bed|^iron bed|^captain's bed", ("Bedroom",), exclude=r"side|bunk|loft|child|baby|sofa"),
+    "Bed": Rule(r"^bed\b|^double bed|^iron bed|^captain's bed", ("Bedroom",),
+                exclude=r"side|bunk|loft|child|baby|sofa"),
     "Brush": Rule(r"^toilet brush$|^brush$", ("Bathroom",)),
     "Burner": Rule(r"cooktop|induction cooker|^hob"),
     "Cabinet": Rule(r"^cupboard$|glass door cabinet|^chest$|filing cabinet", exclude=r"kitchen"),
@@ -72,7 +80,6 @@ RULES: dict[str, Rule] = {
     "Dishwasher": Rule(r"dishwasher"),
     "Dresser": Rule(r"^dresser|chest of drawers|drawers cabinet|^chest$", exclude=r"kitchen"),
     "Drying": Rule(r"towel rack|radiator"),
-    "Keyboard": Rule(r"^keyboard$"),
     "KitchenFurniture": Rule(r"^lower cabinet$|^kitchen cabinet$|^drawers cabinet$", ("Kitchen",)),
     "KitchenFurniture/upper": Rule(r"upper cabinet", ("Kitchen",), exclude=r"corner|shelves"),
     "KitchenFurniture/corner": Rule(r"lower corner cabinet|^lower cabinet$|^kitchen cabinet$", ("Kitchen",)),
@@ -85,7 +92,6 @@ RULES: dict[str, Rule] = {
     "Microwave": Rule(r"microwave"),
     "Nightstand": Rule(r"bedside table|night ?stand|night table"),
     "Oven": Rule(r"^oven$|^small oven$|^double oven$"),
-    "Pouf": Rule(r"pouf|ottoman|footstool"),
     "Refrigerator": Rule(r"fridge|refrigerator"),
     "Shelf": Rule(r"^shelves$|^vertical shelves$|wall shelf"),
     "ShowerCabin": Rule(r"^shower$|shower stall|shower cabin"),
@@ -146,7 +152,7 @@ def catalogue_entries(archive: Path) -> list[Entry]:
     numbers = sorted({int(k.split("#")[1]) for k in props if k.startswith("id#")})
     entries = []
     for i in numbers:
-        def get(key: str, default: str = "") -> str:
+        def get(key: str, default: str = "", i: int = i) -> str:
             return props.get(f"{key}#{i}", default)
         try:
             size = (float(get("width")), float(get("depth")), float(get("height")))
@@ -278,6 +284,7 @@ class Converted:
     face_material: np.ndarray
     materials: list[LibraryMaterial]
     textures: dict[str, bytes]           # file name -> JPEG bytes
+    budget: int                          # the triangles it was simplified towards
 
 
 def convert(entry: Entry, zf: zipfile.ZipFile) -> Converted:
@@ -300,7 +307,8 @@ def convert(entry: Entry, zf: zipfile.ZipFile) -> Converted:
     mesh, uvs, face_material = _simplify(vertices, obj.uvs, faces, face_material, budget)
     materials, textures = _materials(obj.materials, np.unique(face_material))
     remap = {old: new for new, old in enumerate(np.unique(face_material))}
-    return Converted(mesh, uvs, np.array([remap[m] for m in face_material], np.uint8), materials, textures)
+    return Converted(mesh, uvs, np.array([remap[m] for m in face_material], np.uint8), materials, textures,
+                     budget)
 
 
 def _simplify(vertices: np.ndarray, uvs: np.ndarray, faces: np.ndarray, face_material: np.ndarray,
@@ -365,23 +373,19 @@ def _small_jpeg(data: bytes) -> bytes | None:
 
 # --- choosing and writing ----------------------------------------------------------------------
 
-def choose(entries: Sequence[Entry], rules: dict[str, Rule] = RULES,
-           per_kind: int = MAX_PER_TYPE) -> dict[str, list[Entry]]:
+def matches(entries: Sequence[Entry], rules: dict[str, Rule] = RULES) -> dict[str, list[Entry]]:
     """Per object kind, the catalogue entries whose name and category match its rule, in catalogue
-    order, at most ``per_kind``."""
-    out: dict[str, list[Entry]] = {}
-    for kind, rule in rules.items():
-        out[kind] = [e for e in entries if not e.door_or_window and e.category in rule.categories
-                     and re.search(rule.name, e.name.lower()) and not re.search(rule.exclude, e.name.lower())
-                     ][:per_kind]
-    return out
+    order."""
+    return {kind: [e for e in entries if not e.door_or_window and e.category in rule.categories
+                   and re.search(rule.name, e.name.lower()) and not re.search(rule.exclude, e.name.lower())]
+            for kind, rule in rules.items()}
 
 
 def import_furniture(archives: Sequence[Path], out: Path, rules: dict[str, Rule] = RULES,
                      per_kind: int = MAX_PER_TYPE, progress: bool = True) -> dict[str, list[str]]:
     """Import the chosen models of ``archives`` into ``out`` (replacing it); returns kind -> model ids."""
     entries = [e for archive in archives for e in catalogue_entries(Path(archive))]
-    chosen = choose(entries, rules, per_kind)
+    chosen = matches(entries, rules)
     if out.exists():
         shutil.rmtree(out)
     (out / "models").mkdir(parents=True)
@@ -391,8 +395,17 @@ def import_furniture(archives: Sequence[Path], out: Path, rules: dict[str, Rule]
     try:
         for kind, picked in chosen.items():
             written[kind] = []
+            kept: list[tuple[Entry, Converted]] = []
+            smallest: tuple[Entry, Converted] | None = None
             for entry in picked:
+                if len(kept) == per_kind:
+                    break
                 converted = convert(entry, archives_open[entry.archive])
+                if len(converted.mesh.faces) <= max(OVER_BUDGET * converted.budget, ABSOLUTE_BUDGET):
+                    kept.append((entry, converted))
+                elif smallest is None or len(converted.mesh.faces) < len(smallest[1].mesh.faces):
+                    smallest = (entry, converted)
+            for entry, converted in kept or ([smallest] if smallest else []):
                 model_id = _model_id(kind, entry)
                 _write_model(out / "models" / f"{model_id}.npz", converted)
                 for name, data in converted.textures.items():
@@ -418,7 +431,8 @@ def _write_model(path: Path, converted: Converted) -> None:
     buffer = io.BytesIO()
     np.savez_compressed(buffer, vertices=converted.mesh.vertices.astype(np.float32),
                         faces=converted.mesh.faces.astype(np.uint32), uvs=converted.uvs.astype(np.float32),
-                        face_material=converted.face_material.astype(np.uint8))
+                        face_material=converted.face_material.astype(np.uint8),
+                        face_piece=piece_labels(converted.mesh.vertices, converted.mesh.faces).astype(np.uint16))
     path.write_bytes(buffer.getvalue())
 
 

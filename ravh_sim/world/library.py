@@ -7,13 +7,16 @@ Format (``furniture/``, written by ``ravh import-furniture``, :mod:`ravh_sim.wor
   tables, upper kitchen units), its source, creator and licence, its natural ``size`` (m, along
   front, across, up) and its materials (:class:`LibraryMaterial`).
 - ``models/<id>.npz``: ``vertices`` (N, 3) float32 in metres, centred on the model's box, z up,
-  front along +x; ``faces`` (M, 3); ``uvs`` (N, 2); ``face_material`` (M,) into the materials.
+  front along +x; ``faces`` (M, 3); ``uvs`` (N, 2); ``face_material`` (M,) into the materials;
+  ``face_piece`` (M,): the connected piece (leg, seat, back...) each face belongs to.
 - ``textures/*.jpg``: base-colour textures, at most 256 texels a side.
 - ``ATTRIBUTION.md``: every model's creator and licence.
 
-A model is fitted into an object's box by :func:`fit`: scaled uniformly to fill the box as far as
-its proportions allow, then stretched by at most :data:`MAX_STRETCH` per axis towards the box, set
-on the box's floor and against its back; so it always lies inside the box the footprint records.
+A model is fitted into an object's box by :func:`fit`: scaled to the box's height where its
+proportions allow, its width and depth within :data:`MAX_STRETCH` of that scale, set on the box's
+floor and against its back; so it always lies inside the box the footprint records. An object's
+model variants are its kind's models in order of how well they fit its box (:func:`misfit`), so
+the default variant is the best-proportioned one.
 """
 from __future__ import annotations
 
@@ -104,6 +107,7 @@ class LibraryModel:
     faces: np.ndarray                 # (M, 3) int64
     uvs: np.ndarray                   # (N, 2) float32
     face_material: np.ndarray         # (M,) int64
+    face_piece: np.ndarray            # (M,) int64
 
     @property
     def id(self) -> str:
@@ -149,13 +153,14 @@ def kind_of(object_type: str, prefab: str) -> str:
 
 @functools.lru_cache(maxsize=1)
 def catalog() -> LibraryCatalog:
+    """The committed library (an installation without it is broken, not a house without furniture)."""
     path = FURNITURE_DIR / "catalog.json"
     if not path.exists():
-        return LibraryCatalog(format=CATALOG_FORMAT, models=[])
+        raise FileNotFoundError(f"the furniture library is missing: {path} (reinstall ravh_sim)")
     return LibraryCatalog.model_validate_json(path.read_text())
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def models_of(kind: str) -> tuple[LibraryRecord, ...]:
     """The library's models of a kind, in catalogue order (empty: the kind has none)."""
     return tuple(r for r in catalog().models if r.kind == kind)
@@ -166,21 +171,59 @@ def load_model(model_id: str) -> LibraryModel:
     record = next(r for r in catalog().models if r.id == model_id)
     with np.load(FURNITURE_DIR / "models" / f"{model_id}.npz") as data:
         return LibraryModel(record, data["vertices"].astype(np.float64), data["faces"].astype(np.int64),
-                            data["uvs"].astype(np.float32), data["face_material"].astype(np.int64))
+                            data["uvs"].astype(np.float32), data["face_material"].astype(np.int64),
+                            data["face_piece"].astype(np.int64))
+
+
+def fit_scale(natural: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """Per-axis scale of a model of ``natural`` extents into a box of ``size``: the box's height
+    where the model's proportions allow it (the height says most about an object: a fridge, a
+    wardrobe), each horizontal axis within MAX_STRETCH of the height's scale, never beyond the box."""
+    natural = np.maximum(np.asarray(natural, np.float64), 1e-6)
+    ratio = np.asarray(size, np.float64) / natural
+    up = min(ratio[2], MAX_STRETCH * ratio[:2].min())
+    return np.array([min(ratio[0], MAX_STRETCH * up), min(ratio[1], MAX_STRETCH * up), up])
+
+
+def misfit(natural: np.ndarray, size: np.ndarray) -> float:
+    """How far a box's proportions are from a model's: the largest log ratio between the scales its
+    axes would need (0: the model fills the box unstretched)."""
+    ratio = np.log(np.asarray(size, np.float64) / np.maximum(np.asarray(natural, np.float64), 1e-6))
+    return float(ratio.max() - ratio.min())
 
 
 def fit(model: LibraryModel, size: np.ndarray) -> np.ndarray:
-    """The model's vertices scaled into a box of ``size`` (front, across, up) centred at the origin:
-    as large as its proportions allow, stretched by at most MAX_STRETCH per axis towards the box,
-    standing on the box's floor with its back against the box's back (x = -size/2)."""
-    natural = np.maximum(np.ptp(model.vertices, axis=0), 1e-6)
+    """The model's vertices scaled into a box of ``size`` (front, across, up) centred at the origin
+    (:func:`fit_scale`), standing on the box's floor with its back against the box's back
+    (x = -size/2), centred across."""
+    natural = np.ptp(model.vertices, axis=0)
     size = np.asarray(size, np.float64)
-    uniform = float(np.min(size / natural))
-    scale = uniform * np.minimum(size / (uniform * natural), MAX_STRETCH)
+    scale = fit_scale(natural, size)
     vertices = (model.vertices - model.vertices.min(axis=0)) * scale
-    extent = natural * scale
+    extent = np.maximum(natural, 1e-6) * scale
     offset = np.array([-size[0] / 2, -extent[1] / 2, -size[2] / 2])
     return vertices + offset
+
+
+def piece_labels(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Per face, the connected piece it belongs to (faces touching at a vertex position are one
+    piece, across texture seams): union-find over the faces' corners."""
+    _, corner = np.unique(np.round(vertices, 5), axis=0, return_inverse=True)
+    corner = corner.reshape(-1)[faces]                           # (M, 3) position ids
+    parent = np.arange(int(corner.max()) + 1 if len(corner) else 0)
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for a, b, c in corner.tolist():
+        ra = root(a)
+        parent[root(b)] = ra
+        parent[root(c)] = ra
+    roots = np.array([root(i) for i in range(len(parent))], np.int64)
+    return np.unique(roots[corner[:, 0]], return_inverse=True)[1].reshape(-1)
 
 
 def palette_stand_in(fitted: FittedModel) -> Mesh:

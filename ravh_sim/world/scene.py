@@ -29,6 +29,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pybullet as pb
+import trimesh
 
 from ravh_sim.poses import quaternion_from_yaw
 from ravh_sim.render.backend import resolve_backend
@@ -80,6 +81,7 @@ class World:
         self.state = WorldState(settings)
         self.physics_hz = physics_hz
         self.renderer = resolve_backend(renderer)
+        self._pybullet_draws = self.renderer == "tiny"        # else pybullet bodies need no visual shape
         self.client = connect()
         self.visuals: dict[int, Visual] = {}     # pybullet body -> what it looks like
         self.revision = 0                          # grows with every change to a body's look or place
@@ -160,7 +162,7 @@ class World:
         pb.createMultiBody(0, ground, -1, basePosition=[0, 0, self.floor_z - 0.051],
                            physicsClientId=self.client)
         # Every texture loads once, up front: run-time repaints then cost no file I/O.
-        for name in ("palette", "white", *paints.TEXTURES):
+        for name in ("palette", "white", *paints.TEXTURES) if self._pybullet_draws else ():
             self._texture(name)
         self.instances = build_instances(self.house)
         self._by_name = {inst.name: inst for inst in self.instances}
@@ -209,20 +211,27 @@ class World:
             collision = self._model_collision(placed.model)
         else:
             collision = self._parts_collision(placed)
-        mesh = placed.mesh() if placed.model is None else palette_stand_in(placed.model)
-        path = self._asset(mesh_bytes(mesh), ".obj", lambda p: mesh.write_obj(p, PALETTE))
-        body = self._file_body(path, collision, placed.position, placed.yaw)
-        self._set_look(body, self._texture("palette"), [1, 1, 1, 1])
-        self.visuals[body] = Visual(mesh=mesh if placed.model is None else None, model=placed.model)
-        self.triangle_count += mesh.triangle_count
+        mesh = placed.mesh() if placed.model is None else None
+        if self._pybullet_draws:
+            drawn = mesh if mesh is not None else palette_stand_in(placed.model)
+            path = self._asset(mesh_bytes(drawn), ".obj", lambda p: drawn.write_obj(p, PALETTE))
+            body = self._new_body(collision, placed.position, placed.yaw, path)
+            self._set_look(body, self._texture("palette"), [1, 1, 1, 1])
+        else:
+            body = self._new_body(collision, placed.position, placed.yaw)
+        self.visuals[body] = Visual(mesh=mesh, model=placed.model)
+        self.triangle_count += len(placed.model.model.faces) if placed.model is not None else len(mesh.faces)
         return body
 
     def _model_collision(self, fitted: FittedModel) -> int:
         """A library model collides as its own triangles (a static concave mesh: exact for the laser,
-        which then sees what the camera draws)."""
-        return pb.createCollisionShape(pb.GEOM_MESH, vertices=fitted.vertices.tolist(),
-                                       indices=fitted.model.faces.ravel().tolist(),
-                                       flags=pb.GEOM_FORCE_CONCAVE_TRIMESH, physicsClientId=self.client)
+        which then sees what the camera draws), loaded from a cached OBJ file."""
+        mesh = trimesh.Trimesh(fitted.vertices, fitted.model.faces, process=False)
+        key = fitted.model.id.encode() + np.round(fitted.vertices, 5).tobytes()
+        path = self._asset(key, ".obj", lambda p: mesh.export(p, file_type="obj", include_normals=False,
+                                                              include_texture=False))
+        return pb.createCollisionShape(pb.GEOM_MESH, fileName=str(path), flags=pb.GEOM_FORCE_CONCAVE_TRIMESH,
+                                       physicsClientId=self.client)
 
     def _parts_collision(self, placed: Placed) -> int:
         """A compound of one convex hull per model part, loaded from a cached OBJ file."""
@@ -231,15 +240,21 @@ class World:
         return pb.createCollisionShape(pb.GEOM_MESH, fileName=str(path), physicsClientId=self.client)
 
     def _mesh_body(self, mesh: TexturedMesh, collision: int, surface: str) -> int:
-        key = np.concatenate([mesh.vertices.ravel(), mesh.uvs.ravel()]).round(4).tobytes()
-        path = self._asset(key, ".obj", mesh.write_obj)
+        path = None
+        if self._pybullet_draws:
+            key = np.concatenate([mesh.vertices.ravel(), mesh.uvs.ravel()]).round(4).tobytes()
+            path = self._asset(key, ".obj", mesh.write_obj)
         self.triangle_count += mesh.triangle_count
-        body = self._file_body(path, collision, (0, 0, 0), 0.0)
+        body = self._new_body(collision, (0, 0, 0), 0.0, path)
         self.visuals[body] = Visual(structure=mesh, surface=surface)
         return body
 
-    def _file_body(self, path: Path, collision: int, position, yaw: float) -> int:
-        visual = pb.createVisualShape(pb.GEOM_MESH, fileName=str(path), physicsClientId=self.client)
+    def _new_body(self, collision: int, position, yaw: float, visual_file: Path | None = None) -> int:
+        """A static body; with a visual shape from ``visual_file`` only where pybullet draws (the
+        TinyRenderer): our GL renderer draws from :attr:`visuals`, and pybullet's parse of every
+        model's OBJ would only cost build time."""
+        visual = -1 if visual_file is None else pb.createVisualShape(pb.GEOM_MESH, fileName=str(visual_file),
+                                                                    physicsClientId=self.client)
         return pb.createMultiBody(0, collision, visual, basePosition=list(position),
                                   baseOrientation=quaternion_from_yaw(yaw), physicsClientId=self.client)
 
@@ -270,6 +285,8 @@ class World:
     def _apply_paint(self, body: int, paint: str) -> None:
         self.visuals[body].paint = paint
         self.revision += 1
+        if not self._pybullet_draws:
+            return
         if paints.is_texture(paint):
             texture, rgba = self._texture(paint), [1.0, 1.0, 1.0, 1.0]
         else:

@@ -28,8 +28,8 @@ from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
 from ravh_sim.paths import DEFAULT_CONFIG, ROBOTS_DIR
 from ravh_sim.schema import Strict, read_text, shown, validate
 from ravh_sim.world import paints
-from ravh_sim.world.solids import model_count
 from ravh_sim.world.house import House, Light
+from ravh_sim.world.solids import model_count
 
 DOOR_STATES = ("default", *DOOR)          # a settings file may also keep a door as the house has it
 AGENT_CLEARANCE = 0.5      # m between two agents' start positions (two Giraff radii)

@@ -20,12 +20,11 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
-
-from ravh_sim.world.facing import choose_facing, suits_box
 import trimesh
 
 from ravh_sim.world import library
-from ravh_sim.world.furniture import build_parts, front_axis, variant_count
+from ravh_sim.world.facing import choose_facing, front_axis, suits_box
+from ravh_sim.world.furniture import build_parts, variant_count
 from ravh_sim.world.house import Door, House, HouseObject
 from ravh_sim.world.mesh import Mesh, box
 from ravh_sim.world.palette import PALETTE
@@ -92,7 +91,9 @@ def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
     if records:
         if not suits_box(front_axis(obj.type), np.asarray(box.size), facing):
             facing = (facing + 1) % 4
-        fitted, bounds = _fitted(records[variant % len(records)].id, tuple(box.size), facing)
+        size = np.asarray(box.size)[[0, 1, 2] if facing % 2 == 0 else [1, 0, 2]]
+        ranked = sorted(records, key=lambda r: library.misfit(np.asarray(r.size), size))
+        fitted, bounds = _fitted(ranked[variant % len(ranked)].id, tuple(box.size), facing)
         return Placed((), bounds, box.position, obj.yaw, fitted, obj.yaw + facing * math.pi / 2)
     parts, bounds = _parts(obj.type, tuple(box.size), variant, facing, obj.prefab)
     return Placed(parts, bounds, box.position, obj.yaw)
@@ -144,14 +145,13 @@ def _fitted(model_id: str, size: tuple[float, float, float], facing: int
     model = library.load_model(model_id)
     turn = trimesh.transformations.rotation_matrix(facing * np.pi / 2, (0, 0, 1))[:3, :3]
     vertices = library.fit(model, np.array([d, w, h])) @ turn.T
-    return library.FittedModel(model, vertices), _piece_bounds(vertices, model.faces)
+    return library.FittedModel(model, vertices), _piece_bounds(vertices, model.faces, model.face_piece)
 
 
-def _piece_bounds(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+def _piece_bounds(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray) -> np.ndarray:
     """(pieces, 2, 3) boxes of a model's connected pieces (legs, seat, back...), the largest
     MAX_FOOTPRINT_BOXES kept and every smaller piece merged into the nearest kept box, so the
     boxes cover the model and the free-space map sees between its legs."""
-    labels = _piece_labels(vertices, faces)
     corners = vertices[faces]                                    # (M, 3, 3)
     count = int(labels.max()) + 1
     lo = np.full((count, 3), np.inf)
@@ -167,27 +167,6 @@ def _piece_bounds(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
         lo_k[nearest] = np.minimum(lo_k[nearest], lo[piece])
         hi_k[nearest] = np.maximum(hi_k[nearest], hi[piece])
     return np.stack([lo_k, hi_k], axis=1)
-
-
-def _piece_labels(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Per face, the connected piece it belongs to (faces touching at a vertex position are one
-    piece, across texture seams): union-find over the faces' corners."""
-    _, corner = np.unique(np.round(vertices, 5), axis=0, return_inverse=True)
-    corner = corner.reshape(-1)[faces]                           # (M, 3) position ids
-    parent = np.arange(int(corner.max()) + 1)
-
-    def root(i: int) -> int:
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    for a, b, c in corner.tolist():
-        ra, rb, rc = root(a), root(b), root(c)
-        parent[rb] = ra
-        parent[rc] = ra
-    roots = np.array([root(i) for i in range(len(parent))])
-    return np.unique(roots[corner[:, 0]], return_inverse=True)[1].reshape(-1)
 
 
 @functools.lru_cache(maxsize=8192)
