@@ -118,7 +118,7 @@ def test_importer_orients_scales_textures_and_attributes(tmp_path):
 
 def test_import_furniture_command_writes_the_library(tmp_path, capsys):
     from ravh_sim.cli import main
-    archive = build_catalogue(tmp_path / "Test.sh3f")
+    build_catalogue(tmp_path / "Test.sh3f")
     assert main(["import-furniture", str(tmp_path), "-o", str(tmp_path / "lib"), "-q"]) == 0
     assert "imported 1 models of 1 kinds" in capsys.readouterr().out       # the chair, as a Chair
     assert (tmp_path / "lib" / "catalog.json").is_file() and (tmp_path / "lib" / "ATTRIBUTION.md").is_file()

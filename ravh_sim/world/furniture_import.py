@@ -352,10 +352,10 @@ def _materials(mtl: Sequence[dict], used: np.ndarray) -> tuple[list[LibraryMater
             if jpeg is not None:
                 texture = f"textures/{hashlib.sha1(jpeg).hexdigest()[:16]}.jpg"
                 textures[texture] = jpeg
-        kd = tuple(float(np.clip(c, 0.0, 1.0)) for c in m["Kd"])
+        r, g, b = (float(np.clip(c, 0.0, 1.0)) for c in m["Kd"])
         roughness = float(np.clip(np.sqrt(2.0 / (max(m["Ns"], 0.0) + 2.0)), 0.05, 1.0))
         kind = material_kind(m["name"], texture is not None, float(m["d"]))
-        materials.append(LibraryMaterial(name=m["name"], colour=kd, texture=texture, roughness=roughness,  # type: ignore[arg-type]
+        materials.append(LibraryMaterial(name=m["name"], colour=(r, g, b), texture=texture, roughness=roughness,
                                          kind=kind))
     return materials, textures
 
@@ -390,7 +390,8 @@ def import_furniture(archives: Sequence[Path], out: Path, rules: dict[str, Rule]
         shutil.rmtree(out)
     (out / "models").mkdir(parents=True)
     (out / "textures").mkdir()
-    records, written = [], {}
+    records: list[dict] = []
+    written: dict[str, list[str]] = {}
     archives_open = {a: zipfile.ZipFile(a) for a in {e.archive for es in chosen.values() for e in es}}
     try:
         for kind, picked in chosen.items():

@@ -44,7 +44,7 @@ _TEXTURE_STAND_IN = (0.6, 0.5, 0.4)          # a textured material's colour wher
 Kind = Literal["textured", "wood", "fabric", "leather", "metal", "glass", "mirror", "screen", "ceramic",
                "marble", "plant", "emissive", "plain"]
 
-_KIND_WORDS: tuple[tuple[str, str], ...] = (
+_KIND_WORDS: tuple[tuple[Kind, str], ...] = (
     ("mirror", r"mirror|miroir"),
     ("screen", r"screen|display|lcd|monitor|ecran"),
     ("glass", r"glass|verre|crystal|transp"),
@@ -59,7 +59,7 @@ _KIND_WORDS: tuple[tuple[str, str], ...] = (
 )
 
 
-def material_kind(name: str, textured: bool, opacity: float) -> str:
+def material_kind(name: str, textured: bool, opacity: float) -> Kind:
     """What an MTL material is made of, from its name (textured ones keep their texture)."""
     if textured:
         return "textured"

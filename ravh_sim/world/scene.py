@@ -211,16 +211,20 @@ class World:
             collision = self._model_collision(placed.model)
         else:
             collision = self._parts_collision(placed)
-        mesh = placed.mesh() if placed.model is None else None
-        if self._pybullet_draws:
-            drawn = mesh if mesh is not None else palette_stand_in(placed.model)
+        if placed.model is None:
+            drawn = placed.mesh()
+            mesh: Mesh | None = drawn
+            self.triangle_count += drawn.triangle_count
+        else:
+            mesh, drawn = None, palette_stand_in(placed.model) if self._pybullet_draws else None
+            self.triangle_count += len(placed.model.model.faces)
+        if drawn is not None and self._pybullet_draws:
             path = self._asset(mesh_bytes(drawn), ".obj", lambda p: drawn.write_obj(p, PALETTE))
             body = self._new_body(collision, placed.position, placed.yaw, path)
             self._set_look(body, self._texture("palette"), [1, 1, 1, 1])
         else:
             body = self._new_body(collision, placed.position, placed.yaw)
         self.visuals[body] = Visual(mesh=mesh, model=placed.model)
-        self.triangle_count += len(placed.model.model.faces) if placed.model is not None else len(mesh.faces)
         return body
 
     def _model_collision(self, fitted: FittedModel) -> int:
