@@ -22,10 +22,11 @@ CLASSES = {"walls": "walls", "object": "objects", "window": "objects", "door": "
 """Instance kind -> surface class reported."""
 
 
-def laser_minus_depth(laser: Laser, scan: Scan, capture: Capture, pose: tuple[float, float, float]
-                      ) -> dict[str, np.ndarray]:
-    """Per class, depth-image z minus hit z (metres) of every beam of ``scan`` whose hit point the
-    camera sees on the same instance; both sensors at robot pose ``pose``."""
+def laser_minus_depth(laser: Laser, scan: Scan, capture: Capture, pose: tuple[float, float, float],
+                      per_instance: bool = False) -> dict:
+    """Per class (or, with ``per_instance``, per instance id), depth-image z minus hit z (metres) of
+    every beam of ``scan`` whose hit point the camera sees on the same instance; both sensors at
+    robot pose ``pose``."""
     x, y, yaw = pose
     world = laser.world
     assert scan.hit_bodies is not None, "agreement needs a simulated scan (with the bodies hit)"
@@ -46,6 +47,8 @@ def laser_minus_depth(laser: Laser, scan: Scan, capture: Capture, pose: tuple[fl
     seen = np.zeros(len(points), bool)
     seen[inside] = capture.instance[row[inside], col[inside]] == instance[inside]
     differences = capture.depth[row[seen], col[seen]] - local[seen, 2]
+    if per_instance:
+        return {int(i): differences[instance[seen] == i] for i in np.unique(instance[seen])}
     kinds = {inst.id: CLASSES.get(inst.kind) for inst in world.instances}
     labels = np.array([kinds.get(int(i)) for i in instance[seen]], dtype=object)
     return {name: differences[labels == name] for name in set(CLASSES.values())}

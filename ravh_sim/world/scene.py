@@ -211,12 +211,12 @@ class World:
             collision = self._model_collision(placed.model)
         else:
             collision = self._parts_collision(placed)
-        if placed.model is None:
-            drawn = placed.mesh()
-            mesh: Mesh | None = drawn
-            self.triangle_count += drawn.triangle_count
-        else:
-            mesh, drawn = None, palette_stand_in(placed.model) if self._pybullet_draws else None
+        mesh = placed.mesh() if placed.model is None else None
+        drawn = mesh
+        if mesh is not None:
+            self.triangle_count += mesh.triangle_count
+        if placed.model is not None:
+            drawn = palette_stand_in(placed.model) if self._pybullet_draws else None
             self.triangle_count += len(placed.model.model.faces)
         if drawn is not None and self._pybullet_draws:
             path = self._asset(mesh_bytes(drawn), ".obj", lambda p: drawn.write_obj(p, PALETTE))
