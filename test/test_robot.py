@@ -8,6 +8,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import random
+from collections.abc import Callable
 
 import numpy as np
 import pybullet as pb
@@ -118,17 +119,52 @@ def approaches(grid: Grid, rect: Rect, angle: float = 0.0, run: float = 1.0):
             yield (start[0], start[1], math.atan2(-dy, -dx)), (nx, ny)
 
 
-def ram(world: World, pose, seconds: float, watch: list[Rect]) -> tuple[list[float], Robot]:
+def ram(world: World, pose, seconds: float, watch: list[Rect] | Callable[[tuple], float]
+        ) -> tuple[list[float], Robot]:
     """Drive a robot from ``pose`` at full speed for ``seconds``; the least distance from its centre
-    to any of ``watch`` after every physics step."""
+    to any of ``watch`` (rectangles, or a distance function of the centre) after every physics step."""
     sim = Simulation(world, [AgentSpec("robot", "giraff", pose)])
     robot = sim.robot("robot")
     robot.set_command(VMAX, 0.0)
     distances = []
     for _ in range(int(seconds * world.physics_hz)):
         sim.step()
-        distances.append(min(rect_distance(robot.pose[:2], r) for r in watch))
+        xy = robot.pose[:2]
+        distances.append(watch(xy) if callable(watch) else min(rect_distance(xy, r) for r in watch))
     return distances, robot
+
+
+def model_distance(world: World, obj_id: str) -> Callable[[tuple], float]:
+    """Distance on the floor plan from a point to the drawn triangles of a library model that reach
+    into the robot's height band (0 inside one): computed from the model itself, not its colliders."""
+    obj = world.house.object(obj_id)
+    placed = object_parts(world.house, obj, world.state.models[obj_id])
+    assert placed.model is not None
+    floor = world.house.room(obj.room).floor_z
+    c, s = math.cos(placed.yaw), math.sin(placed.yaw)
+    local = placed.model.vertices
+    xyz = np.column_stack([placed.position[0] + c * local[:, 0] - s * local[:, 1],
+                           placed.position[1] + s * local[:, 0] + c * local[:, 1],
+                           placed.position[2] + local[:, 2]])
+    triangles = xyz[placed.model.model.faces]
+    band = (triangles[:, :, 2].max(axis=1) > floor + 0.02) & (triangles[:, :, 2].min(axis=1) < floor + GIRAFF.height)
+    flat = triangles[band][:, :, :2]
+
+    def distance(xy) -> float:
+        p = np.asarray(xy, float)
+        a, b, c_ = flat[:, 0], flat[:, 1], flat[:, 2]
+        cross = [(v - u)[:, 0] * (p - u)[:, 1] - (v - u)[:, 1] * (p - u)[:, 0] for u, v in ((a, b), (b, c_), (c_, a))]
+        inside = ((cross[0] >= 0) & (cross[1] >= 0) & (cross[2] >= 0)) | ((cross[0] <= 0) & (cross[1] <= 0)
+                                                                         & (cross[2] <= 0))
+        if inside.any():
+            return 0.0
+        edges = []
+        for u, v in ((a, b), (b, c_), (c_, a)):
+            d = v - u
+            t = np.clip(np.einsum("ij,ij->i", p - u, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-12), 0, 1)
+            edges.append(np.linalg.norm(u + t[:, None] * d - p, axis=1))
+        return float(np.min(edges))
+    return distance
 
 
 # --------------------------------------------------------------------------- collisions
@@ -184,7 +220,9 @@ def test_full_speed_into_furniture_stops_at_it(make_world, kind):
                 break
     assert found, f"no {kind} with a clear approach in house 15"
     pose, (nx, ny) = found
-    distances, robot = ram(world, pose, seconds=1.0 / VMAX + 4.0, watch=part_rects(world, obj.id))
+    drawn = object_parts(world.house, obj, world.state.models[obj.id]).model is not None
+    distances, robot = ram(world, pose, seconds=1.0 / VMAX + 4.0,
+                           watch=model_distance(world, obj.id) if drawn else part_rects(world, obj.id))
     assert min(distances) >= R - SINK, f"sank {R - min(distances):.3f} m into {obj.id}"
     assert distances[-1] <= R + TOUCH, f"never reached {obj.id}"
     assert (robot.pose[0] - rect[0][0]) * nx + (robot.pose[1] - rect[0][1]) * ny > 0

@@ -34,7 +34,7 @@ from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.house import HOUSE_FORMAT, house_from_dict
 from ravh_sim.world.scene import World
 from ravh_sim.world.settings import load_settings, resolve
-from ravh_sim.world.solids import DOOR_LEAF_THICKNESS
+from ravh_sim.world.solids import DOOR_LEAF_THICKNESS, object_parts
 
 PROFILE = load_profile("giraff")
 WALL = 0.1
@@ -340,11 +340,12 @@ def test_scans_of_a_drive_equal_a_replay_without_the_robot(houses, number):
 
 
 def test_the_laser_sees_between_legs(houses):
-    """At laser height a dining table or chair blocks with its legs, not its box: of rays crossing
-    each one's box (at 9 offsets along each axis), some pass between the legs."""
+    """At laser height a dining table or chair blocks with its modelled legs and frames, not its box:
+    rays crossing each one's box (at 9 offsets along each axis) hit it exactly where an independent
+    ray/triangle intersection with the drawn model says, and some pass between the legs."""
     house = houses[15]
     with World(house, resolve(load_settings(), house), renderer="tiny") as world:
-        checked = 0
+        checked, passed_between = 0, 0
         for obj in house.objects:
             box = obj.box(world.state.models[obj.id])
             if obj.type not in ("Table", "Chair") or box.size[2] < 0.6:     # no coffee tables
@@ -360,10 +361,44 @@ def test_the_laser_sees_between_legs(houses):
                 u, v = box.size[0] / 2 + 0.01, box.size[1] / 2 + 0.01
                 starts += [in_house(-u, t * box.size[1]), in_house(t * box.size[0], -v)]
                 ends += [in_house(u, t * box.size[1]), in_house(t * box.size[0], v)]
-            hits = [h[0] for h in pb.rayTestBatch(starts, ends, physicsClientId=world.client)]
-            assert hits.count(world.instance(obj.id).body) < len(hits), obj.id
+            hits = pb.rayTestBatch(starts, ends, physicsClientId=world.client)
+            body = world.instance(obj.id).body
+            drawn = drawn_hits(object_parts(house, obj, world.state.models[obj.id]), np.array(starts),
+                               np.array(ends))
+            for (hit_body, _, fraction, *_), expected in zip(hits, drawn):
+                assert (hit_body == body) == np.isfinite(expected), obj.id
+                if hit_body == body:
+                    assert fraction == pytest.approx(expected, abs=0.002), obj.id
+            passed_between += any(h[0] != body for h in hits) and any(h[0] == body for h in hits)
             checked += 1
-    assert checked >= 3
+    assert checked >= 3 and passed_between >= 1
+
+
+def drawn_hits(placed, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """Per ray, the fraction along it where it first meets the drawn triangles of a placed library
+    model (Moller-Trumbore), inf where it misses them."""
+    c, s = math.cos(placed.yaw), math.sin(placed.yaw)
+    v = placed.model.vertices
+    xyz = np.column_stack([placed.position[0] + c * v[:, 0] - s * v[:, 1],
+                           placed.position[1] + s * v[:, 0] + c * v[:, 1], placed.position[2] + v[:, 2]])
+    a, b, c_ = (xyz[placed.model.model.faces[:, k]] for k in range(3))
+    e1, e2 = b - a, c_ - a
+    out = np.full(len(starts), np.inf)
+    for i, (p, q) in enumerate(zip(starts, ends)):
+        d = q - p
+        h = np.cross(d, e2)
+        det = np.einsum("ij,ij->i", e1, h)
+        ok = np.abs(det) > 1e-12
+        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+        w = p - a
+        u = np.einsum("ij,ij->i", w, h) * inv
+        qv = np.cross(w, e1)
+        vv = (qv @ d) * inv
+        t = np.einsum("ij,ij->i", e2, qv) * inv
+        hit = ok & (u >= 0) & (vv >= 0) & (u + vv <= 1) & (t >= 0) & (t <= 1)
+        if hit.any():
+            out[i] = t[hit].min()
+    return out
 
 
 def test_closing_a_door_changes_laser_and_depth_in_the_doorway(world, camera, appearance):

@@ -20,6 +20,7 @@ from ravh_sim.poses import quaternion_from_yaw
 from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import House
 from ravh_sim.world.settings import Resolved
+from ravh_sim.world.solids import object_parts
 
 FOOTPRINT_FORMAT = "ravh_sim/footprint@1"
 STRUCTURE_KINDS = ("floor", "ceiling", "walls")
@@ -65,18 +66,21 @@ def build_instances(house: House) -> list[Instance]:
 
 
 def instance_pose(house: House, models: Mapping[str, int], inst: Instance) -> dict[str, Any]:
-    """Position, orientation and model of an instance when objects have ``models``."""
+    """Position, orientation and model of an instance when objects have ``models``; ``asset`` names
+    the furniture-library model drawn (see furniture/ATTRIBUTION.md), None for procedural ones."""
     if inst.kind in STRUCTURE_KINDS:
         room = house.room(inst.room)
         cx, cy = polygon_centroid(room.floor)
         z = {"floor": room.floor_z, "ceiling": room.ceiling_z, "walls": (room.floor_z + room.ceiling_z) / 2}
         return {"position": _r([cx, cy, z[inst.kind]]), "orientation": [0.0, 0.0, 0.0, 1.0], "yaw": 0.0,
-                "model": None, "size": None}
+                "model": None, "size": None, "asset": None}
     obj = house.object(inst.name)
     model = models[obj.id]
     box = obj.box(model)
+    fitted = object_parts(house, obj, model).model
     return {"position": _r(box.position), "orientation": _r(quaternion_from_yaw(obj.yaw)),
-            "yaw": _r(obj.yaw), "model": model, "size": _r(box.size)}
+            "yaw": _r(obj.yaw), "model": model, "size": _r(box.size),
+            "asset": fitted.model.id if fitted is not None else None}
 
 
 def make_footprint(house: House, settings: Resolved) -> dict[str, Any]:

@@ -89,14 +89,28 @@ def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
     variant = obj.default_model if model is None else model
     records = library.models_of(library.kind_of(obj.type, obj.prefab))
     if records:
-        if not suits_box(front_axis(obj.type), np.asarray(box.size), facing):
-            facing = (facing + 1) % 4
-        size = np.asarray(box.size)[[0, 1, 2] if facing % 2 == 0 else [1, 0, 2]]
-        ranked = sorted(records, key=lambda r: library.misfit(np.asarray(r.size), size))
-        fitted, bounds = _fitted(ranked[variant % len(ranked)].id, tuple(box.size), facing)
+        record, facing = _library_choice(records, variant, np.asarray(box.size), facing, front_axis(obj.type))
+        fitted, bounds = _fitted(record.id, tuple(box.size), facing)
         return Placed((), bounds, box.position, obj.yaw, fitted, obj.yaw + facing * math.pi / 2)
     parts, bounds = _parts(obj.type, tuple(box.size), variant, facing, obj.prefab)
     return Placed(parts, bounds, box.position, obj.yaw)
+
+
+def _library_choice(records: tuple[library.LibraryRecord, ...], variant: int, size: np.ndarray, facing: int,
+                    front: str) -> tuple[library.LibraryRecord, int]:
+    """Model variant ``variant`` of an object and the facing it is drawn at: the kind's models in
+    order of how well they fit the box, each turned the way it fits best where the type's front
+    may look either way along the box ('any': a table's long side follows the box's long side)."""
+    if not suits_box(front, size, facing):
+        facing = (facing + 1) % 4
+    facings = (facing, (facing + 1) % 4) if front == "any" else (facing,)
+
+    def misfit(record: library.LibraryRecord, f: int) -> float:
+        return library.misfit(np.asarray(record.size), size[[0, 1, 2] if f % 2 == 0 else [1, 0, 2]])
+
+    ranked = sorted(records, key=lambda r: min(misfit(r, f) for f in facings))
+    record = ranked[variant % len(ranked)]
+    return record, min(facings, key=lambda f: misfit(record, f))
 
 
 def model_count(obj: HouseObject) -> int:
