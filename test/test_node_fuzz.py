@@ -9,19 +9,17 @@ from __future__ import annotations
 import json
 
 import pytest
+import rclpy
+from diagnostic_msgs.srv import AddDiagnostics
+from geometry_msgs.msg import Twist
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from nav_msgs.srv import GetMap, GetPlan
 from rosgraph import NodeProcess, spin_until, start_rclpy
+from std_srvs.srv import Trigger
 
-rclpy = pytest.importorskip("rclpy")
-
-from diagnostic_msgs.srv import AddDiagnostics  # noqa: E402
-from geometry_msgs.msg import Twist  # noqa: E402
-from nav_msgs.srv import GetMap, GetPlan  # noqa: E402
-from std_srvs.srv import Trigger  # noqa: E402
-
-from ravh_msgs_py import names as n  # noqa: E402
-from ravh_msgs_py.query import QUERIES  # noqa: E402
+from ravh_msgs_py import names as n
+from ravh_msgs_py.query import QUERIES
 
 WORDS = ["Door_0", "Door_1", "Bed_0", "Chair_0", "Light_0", "Bedroom_1", "Bathroom_1", "all", "ceiling",
          "lamps", "random", "on", "off", "open", "closed", "walls", "floor", "brick", "#ff0000", "night"]
@@ -55,18 +53,21 @@ cheap_appearance = st.fixed_dictionaries({}, optional={
 
 @pytest.fixture(scope="module")
 def node():
-    proc = NodeProcess("sim", "--house", "20", "--camera-rate", "0")
-    start_rclpy()
-    probe = rclpy.create_node("fuzzer")
-    clients = {name: probe.create_client(AddDiagnostics, name) for name in (n.QUERY_SERVICE, n.APPEARANCE_SERVICE)}
-    clients.update({n.GET_PLAN_SERVICE: probe.create_client(GetPlan, n.GET_PLAN_SERVICE),
-                    n.GET_MAP_SERVICE: probe.create_client(GetMap, n.GET_MAP_SERVICE),
-                    n.RESET_SERVICE: probe.create_client(Trigger, n.RESET_SERVICE),
-                    n.CAPTURE_SERVICE: probe.create_client(Trigger, n.CAPTURE_SERVICE)})
-    assert all(c.wait_for_service(timeout_sec=90) for c in clients.values()), proc.log()[-2000:]
-    yield proc, probe, clients, probe.create_publisher(Twist, n.CMD_VEL, 10)
-    probe.destroy_node()
-    assert proc.stop() == 0, proc.log()[-3000:]
+    with NodeProcess("sim", "--house", "20", "--camera-rate", "0") as proc:
+        start_rclpy()
+        probe = rclpy.create_node("fuzzer")
+        try:
+            clients = {name: probe.create_client(AddDiagnostics, name)
+                       for name in (n.QUERY_SERVICE, n.APPEARANCE_SERVICE)}
+            clients.update({n.GET_PLAN_SERVICE: probe.create_client(GetPlan, n.GET_PLAN_SERVICE),
+                            n.GET_MAP_SERVICE: probe.create_client(GetMap, n.GET_MAP_SERVICE),
+                            n.RESET_SERVICE: probe.create_client(Trigger, n.RESET_SERVICE),
+                            n.CAPTURE_SERVICE: probe.create_client(Trigger, n.CAPTURE_SERVICE)})
+            assert all(c.wait_for_service(timeout_sec=90) for c in clients.values()), proc.log()[-2000:]
+            yield proc, probe, clients, probe.create_publisher(Twist, n.CMD_VEL, 10)
+        finally:
+            probe.destroy_node()
+        assert proc.stop() == 0, proc.log()[-3000:]
     assert "Traceback" not in proc.log()
 
 

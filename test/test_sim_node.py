@@ -7,25 +7,23 @@ import time
 
 import numpy as np
 import pytest
+import rclpy
+from diagnostic_msgs.srv import AddDiagnostics
+from geometry_msgs.msg import PoseStamped, TransformStamped, Twist
+from nav_msgs.msg import OccupancyGrid, Odometry
+from nav_msgs.srv import GetMap, GetPlan
 from rosgraph import NodeProcess, spin_until, start_rclpy
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import CameraInfo, CompressedImage, Image, LaserScan
+from std_msgs.msg import String
+from std_srvs.srv import Trigger
 
-rclpy = pytest.importorskip("rclpy")
-
-from diagnostic_msgs.srv import AddDiagnostics  # noqa: E402
-from geometry_msgs.msg import PoseStamped, TransformStamped, Twist  # noqa: E402
-from nav_msgs.msg import OccupancyGrid, Odometry  # noqa: E402
-from nav_msgs.srv import GetMap, GetPlan  # noqa: E402
-from rosgraph_msgs.msg import Clock  # noqa: E402
-from sensor_msgs.msg import CameraInfo, CompressedImage, Image, LaserScan  # noqa: E402
-from std_msgs.msg import String  # noqa: E402
-from std_srvs.srv import Trigger  # noqa: E402
-
-from ravh_msgs_py import names as n  # noqa: E402
-from ravh_msgs_py.capture import CaptureEvent  # noqa: E402
-from ravh_msgs_py.client import RavhClient  # noqa: E402
-from ravh_sim.nav.grid import FREE  # noqa: E402
-from ravh_sim.nodes import convert  # noqa: E402
-from ravh_sim.nodes.common import LATCHED_QOS, SENSOR_QOS, STATE_QOS  # noqa: E402
+from ravh_msgs_py import names as n
+from ravh_msgs_py.capture import CaptureEvent
+from ravh_msgs_py.client import RavhClient
+from ravh_sim.nav.grid import FREE
+from ravh_sim.nodes import convert
+from ravh_sim.nodes.common import LATCHED_QOS, SENSOR_QOS, STATE_QOS
 
 HOUSE = "20"
 TOPICS = {   # topic: (type, qos, expected frame_id or None)
@@ -83,13 +81,15 @@ class Probe:
 
 @pytest.fixture(scope="module")
 def sim():
-    proc = NodeProcess("sim", "--house", HOUSE, "--seed", "0")
-    probe = Probe()
-    ok = spin_until(probe.node, lambda: len(probe.got[n.COLOR_IMAGE]) >= 3 and probe.got[n.GROUND_TRUTH], 90)
-    assert ok, f"sim did not publish images:\n{proc.log()[-3000:]}"
-    yield proc, probe
-    probe.close()
-    code = proc.stop()
+    with NodeProcess("sim", "--house", HOUSE, "--seed", "0") as proc:
+        probe = Probe()
+        try:
+            ok = spin_until(probe.node, lambda: len(probe.got[n.COLOR_IMAGE]) >= 3 and probe.got[n.GROUND_TRUTH], 90)
+            assert ok, f"sim did not publish images:\n{proc.log()[-3000:]}"
+            yield proc, probe
+        finally:
+            probe.close()
+        code = proc.stop()
     assert code == 0, f"sim did not stop cleanly on SIGINT (exit {code}):\n{proc.log()[-3000:]}"
     assert "Traceback" not in proc.log()
 

@@ -12,23 +12,21 @@ from collections import deque
 import cv2
 import numpy as np
 import pytest
+import rclpy
+from geometry_msgs.msg import PoseStamped, TransformStamped
+from nav_msgs.msg import OccupancyGrid
+from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
+from rcl_interfaces.srv import SetParameters
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph import NodeProcess, spin_until, start_rclpy
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import Image, LaserScan
+from tf2_msgs.msg import TFMessage
 
-rclpy = pytest.importorskip("rclpy")
-
-from geometry_msgs.msg import PoseStamped, TransformStamped  # noqa: E402
-from nav_msgs.msg import OccupancyGrid  # noqa: E402
-from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue  # noqa: E402
-from rcl_interfaces.srv import SetParameters  # noqa: E402
-from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
-from rosgraph_msgs.msg import Clock  # noqa: E402
-from sensor_msgs.msg import Image, LaserScan  # noqa: E402
-from tf2_msgs.msg import TFMessage  # noqa: E402
-
-from ravh_msgs_py import names as n  # noqa: E402
-from ravh_sim.nav.grid import FREE, OCCUPIED  # noqa: E402
-from ravh_sim.nodes import convert  # noqa: E402
-from ravh_sim.nodes.common import LATCHED_QOS, SENSOR_QOS, STATE_QOS  # noqa: E402
+from ravh_msgs_py import names as n
+from ravh_sim.nav.grid import FREE, OCCUPIED
+from ravh_sim.nodes import convert
+from ravh_sim.nodes.common import LATCHED_QOS, SENSOR_QOS, STATE_QOS
 
 CONFIG = """agents:
   - {name: robot, profile: giraff, start: station}
@@ -96,14 +94,16 @@ class Watcher:
 def sim(tmp_path_factory):
     cfg = tmp_path_factory.mktemp("tf") / "two.yaml"
     cfg.write_text(CONFIG)
-    proc = NodeProcess("sim", "--house", "20", "--seed", "0", "--config", str(cfg), "--camera-rate", "3",
-                       "--scan-rate", "7")          # rates whose periods fall between /clock ticks
-    watcher = Watcher()
-    ok = spin_until(watcher.node, lambda: all(watcher.sensors.values()) and watcher.map_odom(), 90)
-    assert ok, f"sim did not start:\n{proc.log()[-3000:]}"
-    yield proc, watcher
-    watcher.node.destroy_node()
-    assert proc.stop() == 0, proc.log()[-3000:]
+    with NodeProcess("sim", "--house", "20", "--seed", "0", "--config", str(cfg), "--camera-rate", "3",
+                     "--scan-rate", "7") as proc:          # rates whose periods fall between /clock ticks
+        watcher = Watcher()
+        try:
+            ok = spin_until(watcher.node, lambda: all(watcher.sensors.values()) and watcher.map_odom(), 90)
+            assert ok, f"sim did not start:\n{proc.log()[-3000:]}"
+            yield proc, watcher
+        finally:
+            watcher.node.destroy_node()
+        assert proc.stop() == 0, proc.log()[-3000:]
     assert "Traceback" not in proc.log()
 
 
