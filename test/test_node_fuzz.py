@@ -7,14 +7,16 @@ must be a well-formed envelope that never says ``internal``, and afterwards ever
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 import rclpy
 from diagnostic_msgs.srv import AddDiagnostics
-from geometry_msgs.msg import Twist
+from geometry_msgs.msg import PoseStamped, Twist
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from nav_msgs.srv import GetMap, GetPlan
+from rclpy.qos import QoSProfile
 from rosgraph import NodeProcess, spin_until, start_rclpy
 from std_srvs.srv import Trigger
 
@@ -109,11 +111,28 @@ def test_random_appearance_changes_get_envelopes(node, req):
 @FUZZ
 @given(v=st.floats(allow_nan=True, allow_infinity=True), w=st.floats(allow_nan=True, allow_infinity=True))
 def test_random_velocities_never_hurt(node, v, w):
-    _, probe, _, cmd = node
+    proc, probe, _, cmd = node
     msg = Twist()
     msg.linear.x, msg.angular.z = v, w
     cmd.publish(msg)
     rclpy.spin_once(probe, timeout_sec=0)
+    assert proc.alive(), proc.log()[-3000:]
+
+
+def test_after_random_velocities_the_robot_is_whole_and_inside_the_house(node):
+    """What the velocities above did: the robot's true pose is finite and inside a room of house 20."""
+    _, probe, clients, cmd = node
+    cmd.publish(Twist())
+    poses: list[PoseStamped] = []
+    sub = probe.create_subscription(PoseStamped, n.GROUND_TRUTH_POSE, poses.append, QoSProfile(depth=10))
+    try:
+        assert spin_until(probe, lambda: len(poses) >= 3, 60)
+    finally:
+        probe.destroy_subscription(sub)
+    p, q = poses[-1].pose.position, poses[-1].pose.orientation
+    assert all(math.isfinite(v) for v in (p.x, p.y, p.z, q.z, q.w))
+    room = call(probe, clients[n.QUERY_SERVICE], json.dumps({"query": "room_at", "x": p.x, "y": p.y}))
+    assert room["ok"] and room["result"] is not None, (p.x, p.y)
 
 
 @settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
