@@ -452,7 +452,7 @@ def _distinct_floors(source: str, rooms: Sequence[_Room]) -> None:
     """Two rooms on one floor outline are a copy-paste slip (room_at could answer either)."""
     seen: dict[frozenset, str] = {}
     for i, r in enumerate(rooms):
-        key = frozenset((round(x, 3), round(y, 3)) for x, y in r.floor)
+        key = frozenset((round(x, 3), round(y, 3)) for x, y in map(_xy, r.floor))
         if key in seen:
             raise FileFieldError(source, f"rooms[{i}].floor", f"the same outline as room {seen[key]!r}")
         seen[key] = r.id
@@ -472,16 +472,21 @@ def _on_the_plan(source: str, f: HouseFile) -> None:
     for i, o in enumerate(f.objects):
         c, s = abs(math.cos(o.yaw)), abs(math.sin(o.yaw))
         for j, m in enumerate(o.models):
-            (x, y, _), (sx, sy, _) = m.position, m.size
+            (x, y), (sx, sy) = _xy(m.position), _xy(m.size)
             check(f"objects[{i}].models[{j}]", x, y, (c * sx + s * sy) / 2, (s * sx + c * sy) / 2)
     placed: dict[str, Sequence[_Door | _Window | _Light]] = {"doors": f.doors, "windows": f.windows,
                                                               "lights": f.lights}
     for kind, items in placed.items():
         for i, item in enumerate(items):
-            check(f"{kind}[{i}].position", *item.position[:2])
+            check(f"{kind}[{i}].position", *_xy(item.position))
     for i, w in enumerate(f.walls):
-        check(f"walls[{i}].a", *w.a)
-        check(f"walls[{i}].b", *w.b)
+        check(f"walls[{i}].a", *_xy(w.a))
+        check(f"walls[{i}].b", *_xy(w.b))
+
+
+def _xy(point: Any) -> tuple[float, float]:
+    """x, y of a validated point or size (the schema's tuple types are built at run time)."""
+    return float(point[0]), float(point[1])
 
 
 def _poly(points: list) -> Polygon:
