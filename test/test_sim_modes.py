@@ -1,14 +1,19 @@
-"""The sim's start-up modes, each in its own sim: map_tf on and off, stamped velocity commands."""
+"""The sim's start-up modes, each in its own sim: map_tf on and off, stamped velocity commands; and
+``ravh probe`` against a running sim."""
 from __future__ import annotations
 
+import json
 import math
+import subprocess
+import sys
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 
+from conftest import ROOT
 from geometry_msgs.msg import TransformStamped, TwistStamped
 from rclpy.qos import QoSProfile
-from rosgraph import NodeProcess, spin_until
+from rosgraph import NodeProcess, ros_env, spin_until
 from test_sim_tf import SLAM_X, Watcher, stamp_ns
 
 from ravh_msgs_py import names as n
@@ -73,3 +78,23 @@ def test_map_tf_on_keeps_publishing_while_slam_does():
                 and stamp_ns(t.header.stamp) > slam_from + 2_000_000_000]
         assert len(ours) >= 10, proc.log()[-3000:]
         assert "another node publishes" not in proc.log()
+
+
+def test_probe_reports_what_the_sim_publishes():
+    """``ravh probe`` on a sim with its camera off: scans and odometry with rates and latencies, no images."""
+    with sim_with("--scan-rate", "10") as (_, watcher):
+        probe = subprocess.Popen([sys.executable, "-m", "ravh_sim.cli", "probe", "--seconds", "3", "--warmup", "1"],
+                                 cwd=ROOT, env=ros_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            while probe.poll() is None:
+                watcher.spin(0.1)                     # the sim goes on meanwhile; the probe ends by itself
+            out, err = probe.communicate(timeout=60)
+        finally:
+            probe.kill()
+            probe.wait()
+    assert probe.returncode == 0, err[-2000:]
+    report = json.loads(out.strip().splitlines()[-1])
+    for topic in (n.SCAN, n.ODOM):
+        assert report[topic]["count"] >= 2 and report[topic]["rate_hz"] > 0, report
+        assert report[topic]["latency_ms_median"] <= report[topic]["latency_ms_p95"], report
+    assert report[n.COLOR_IMAGE] == {"count": 0} and report["real_time_factor"] > 0
