@@ -347,13 +347,11 @@ def sim():
 def start_recorder(sim, out: Path, *args: str) -> NodeProcess:
     _, node, _ = sim
     rec = NodeProcess("recorder", "--out", str(out), *args)
-    ready = spin_until(node, lambda: (out / layout.DATASET_JSON).exists()
-                       and node.count_subscribers("/" + n.CAPTURE_EVENT) >= 1
-                       and node.count_subscribers("/" + n.DEPTH_IMAGE) >= 1, 30)
+    from ravh_sim.nodes.recorder_node import MATCHED_LOG
+    ready = spin_until(node, lambda: (out / layout.DATASET_JSON).exists() and MATCHED_LOG in rec.log(), 30)
     if not ready:
         rec.stop()
         pytest.fail(f"recorder not ready:\n{rec.log()[-3000:]}")
-    spin_until(node, lambda: False, 1.0)                      # let the sim's writers match it
     return rec
 
 
