@@ -3,7 +3,8 @@
 Each file kind declares its fields, types and bounds as a pydantic model (strict: ``1.5`` is not an
 integer, ``true`` is not a number, unknown keys are errors). :func:`validate` turns pydantic's report
 into the project's one-line :class:`FileFieldError` naming the file and the field path of the first
-problem; :func:`read_text` reads a file so that unreadable or non-UTF-8 files fail the same way.
+problem; :func:`read_text` reads a file so that unreadable, oversized or non-UTF-8 files fail the same
+way, and :func:`load_yaml` parses YAML without aliases, so what a file expands to is bounded by its size.
 """
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import types
 from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
+import yaml
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
 from pydantic_core import ErrorDetails
 
@@ -19,6 +21,7 @@ from ravh_sim.errors import FileFieldError, UserError
 
 M = TypeVar("M", bound=BaseModel)
 SHOWN_INPUT = 40          # characters of a bad value quoted in an error (never echo a huge input)
+MAX_FILE_BYTES = 1 << 20  # a settings file or robot profile; the shipped ones are ~2 KB
 
 
 class Strict(BaseModel):
@@ -83,11 +86,39 @@ def shown(value: Any) -> str:
     return text if len(text) <= SHOWN_INPUT else text[:SHOWN_INPUT - 3] + "..."
 
 
-def read_text(path: Path, what: str) -> str:
-    """The UTF-8 text of ``path``; unreadable or undecodable files raise a one-line UserError."""
+def read_text(path: Path, what: str, max_bytes: int = MAX_FILE_BYTES) -> str:
+    """The UTF-8 text of ``path``; unreadable, oversized or undecodable files raise a one-line UserError."""
     try:
-        return path.read_text(encoding="utf-8")
+        with open(path, "rb") as f:
+            data = f.read(max_bytes + 1)               # never more: a pipe or /dev/zero has no size to stat
     except OSError as e:
         raise UserError(f"{path}: cannot read {what}: {e.strerror}") from None
+    if len(data) > max_bytes:
+        raise FileFieldError(str(path), "(file)", f"over the {max_bytes // 1024} KiB limit for a {what}")
+    try:
+        return data.decode("utf-8")
     except UnicodeDecodeError as e:
         raise FileFieldError(str(path), f"byte {e.start}", f"not UTF-8 text ({what})") from None
+
+
+class _NoAliasLoader(yaml.SafeLoader):
+    """SafeLoader that refuses aliases (``*name``): a few KB of nested aliases (a "billion laughs")
+    expand to gigabytes; without them a document has at most as many nodes as its file has bytes."""
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        if self.check_event(yaml.AliasEvent):
+            mark = self.peek_event().start_mark
+            raise yaml.composer.ComposerError(None, None, "aliases (*name) are not allowed", mark)
+        return super().compose_node(parent, index)
+
+
+def load_yaml(text: str, path: str | Path) -> Any:
+    """The YAML document ``text`` (from ``path``); aliases, bad syntax and deep nesting are one-line errors."""
+    try:
+        return yaml.load(text, Loader=_NoAliasLoader)     # a SafeLoader
+    except RecursionError:
+        raise FileFieldError(str(path), "(top level)", "nested too deeply") from None
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = f"line {mark.line + 1} column {mark.column + 1}" if mark else "(top level)"
+        raise FileFieldError(str(path), where, f"invalid YAML: {getattr(e, 'problem', None) or e}") from None

@@ -42,6 +42,17 @@ def resolved(house, settings=None, seed=0):
     return resolve(settings or load_settings(), house, seed)
 
 
-def pytest_report_header(config) -> str:
+def pytest_sessionfinish(session, exitstatus) -> None:
+    """Remove the node logs this run wrote (rosgraph.NodeProcess): a failing test has already quoted them."""
+    import glob
+    for path in glob.glob(f"/tmp/ravh_*_{os.getpid()}_*.log"):
+        os.remove(path)
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_sessionstart(session) -> None:
+    """Say which ROS domain the run uses, after the header and also under -q (which hides the header)."""
     from rosgraph import DOMAIN_ID, DOMAIN_ID_SOURCE
-    return f"ROS_DOMAIN_ID {DOMAIN_ID} ({DOMAIN_ID_SOURCE})"
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    if reporter is not None:
+        reporter.write_line(f"ROS_DOMAIN_ID {DOMAIN_ID} ({DOMAIN_ID_SOURCE})")

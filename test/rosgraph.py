@@ -36,6 +36,12 @@ class NodeProcess:
         self.proc = subprocess.Popen([sys.executable, "-m", "ravh_sim.cli", name, *args], cwd=ROOT,
                                      env=ros_env(), stdout=self._log, stderr=subprocess.STDOUT)
 
+    def __enter__(self) -> NodeProcess:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
     def alive(self) -> bool:
         return self.proc.poll() is None
 
@@ -46,7 +52,8 @@ class NodeProcess:
             return f.read()
 
     def stop(self, timeout: float = 20.0) -> int:
-        """SIGINT, wait; returns the exit code (SIGKILL only as a last resort, reported as -9)."""
+        """SIGINT, wait; returns the exit code (SIGKILL only as a last resort, reported as -9). Safe to call
+        again: a fixture's ``finally`` stops what a test may already have stopped."""
         if self.alive():
             self.proc.send_signal(signal.SIGINT)
             try:
@@ -56,6 +63,15 @@ class NodeProcess:
                 self.proc.wait()
         self._log.close()
         return self.proc.returncode
+
+
+def read_line(stream: Any, timeout: float) -> str:
+    """The next line a child writes to its pipe, or "" if none comes within ``timeout``: a bare
+    readline() on a child that hangs would hang the test."""
+    import select
+    if select.select([stream], [], [], timeout)[0]:
+        return stream.readline()
+    return ""
 
 
 def spin_until(node: Any, condition: Callable[[], bool], timeout: float) -> bool:

@@ -5,13 +5,10 @@ import json
 from types import SimpleNamespace
 
 import pytest
+from rclpy.task import Future
+from std_msgs.msg import String
 
-pytest.importorskip("rclpy")
-
-from rclpy.task import Future  # noqa: E402
-from std_msgs.msg import String  # noqa: E402
-
-from ravh_sim.nodes.behaviour_node import BehaviourNode  # noqa: E402
+from ravh_sim.nodes.behaviour_node import BehaviourNode
 
 
 def waiting_node() -> BehaviourNode:

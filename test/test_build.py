@@ -44,6 +44,7 @@ def test_house_and_raid_lists():
     assert raid_seed(20, 1, None) == 201 and raid_seed(20, 1, 3) != raid_seed(20, 1, 4)
 
 
+@pytest.mark.timeout(1200)
 def test_build_is_interrupted_and_resumed_without_redoing_finished_raids(tmp_path):
     out = tmp_path / "ds"
     args = ("dataset", "build", "--houses", "20,29", "--raids", "0,1", "--workers", "2", "--out", str(out), *SMALL)
@@ -146,6 +147,7 @@ class RayCluster:
         shutil.rmtree(self.temp, ignore_errors=True)
 
 
+@pytest.mark.timeout(1200)
 def test_ray_cluster_of_two_nodes_builds_two_raids(tmp_path):
     """The build as Ray tasks on a head and a worker node (the driver in its own process, as the CLI
     runs it): one raid per node, and the same files as a build on the local pool."""

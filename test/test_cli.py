@@ -62,7 +62,7 @@ def test_plan_writes_a_picture(capsys, tmp_path):
 ])
 def test_user_errors_are_one_line_without_traceback(argv, needle, tmp_path):
     proc = subprocess.run([sys.executable, "-m", "ravh_sim.cli", *argv], capture_output=True, text=True,
-                          cwd=tmp_path, env=subprocess_env())
+                          cwd=tmp_path, env=subprocess_env(), timeout=120)
     assert proc.returncode == 2
     assert needle in proc.stderr and "Traceback" not in proc.stderr
     assert proc.stderr.strip().count("\n") == 0

@@ -7,9 +7,7 @@ import sys
 
 import pytest
 from conftest import ROOT
-from rosgraph import ros_env
-
-pytest.importorskip("rclpy")
+from rosgraph import read_line, ros_env
 
 # A node that sends itself SIGINT at the worst instant: while rclpy converts a message it took (the
 # message class's __init__ runs inside rclpy's C++ take_message). A KeyboardInterrupt raised there
@@ -73,12 +71,13 @@ def test_a_stop_signal_while_spinning_closes_the_node(signum):
     proc = subprocess.Popen([sys.executable, "-c", node], cwd=ROOT, env=ros_env(), stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, text=True)
     assert proc.stdout is not None
-    first = proc.stdout.readline()
-    proc.send_signal(signum)
     try:
+        first = read_line(proc.stdout, 120)
+        proc.send_signal(signum)
         rest = proc.communicate(timeout=60)[0]
     finally:
         proc.kill()
+        proc.wait()
     assert first == "spinning\n", first + rest
     assert proc.returncode == 0, rest
     assert "closed" in rest and "Traceback" not in rest, rest

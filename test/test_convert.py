@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 
+import cv2
 import numpy as np
 import pytest
 
@@ -27,7 +28,7 @@ SENSOR_VALUES = {
     "rgb8": np.random.default_rng(0).integers(0, 255, (4, 5, 3), dtype=np.uint8),
     "32FC1": np.array([[0.5, np.nan, 3.0], [1.25, 2.0, np.inf]], np.float32),
     "16UC1": np.array([[0, 7, 65535], [12, 0, 300]], np.uint16),
-    "jpeg": bytes(range(256)),
+    "jpeg": cv2.imencode(".jpg", np.random.default_rng(1).integers(0, 255, (48, 64, 3), dtype=np.uint8))[1].tobytes(),
     "camera_info": INFO,
     "laser_scan": _scan(),
 }
@@ -45,6 +46,8 @@ def test_sensor_kinds_round_trip(kind):
     value = conv.from_message(msg)
     again = conv.to_message(value, HDR)
     assert again == msg
+    if kind == "jpeg":                       # still a JPEG of the same picture
+        assert value == SENSOR_VALUES[kind] and cv2.imdecode(np.frombuffer(value, np.uint8), 1).shape == (48, 64, 3)
     if isinstance(value, np.ndarray):
         assert value.dtype == SENSOR_VALUES[kind].dtype
         assert np.array_equal(value, SENSOR_VALUES[kind], equal_nan=True)

@@ -30,7 +30,7 @@ def test_ros2_run_launchers_exist_and_start(tmp_path):
 def test_installed_package_finds_its_data(tmp_path):
     code = "from ravh_sim.paths import HOUSES_DIR; print(HOUSES_DIR)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path,
-                         env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"})
+                         env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"}, timeout=120)
     assert out.returncode == 0 and Path(out.stdout.strip()) == PREFIX / "share/ravh_sim/houses"
 
 

@@ -7,21 +7,21 @@ must be a well-formed envelope that never says ``internal``, and afterwards ever
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
+import rclpy
+from diagnostic_msgs.srv import AddDiagnostics
+from geometry_msgs.msg import PoseStamped, Twist
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from nav_msgs.srv import GetMap, GetPlan
+from rclpy.qos import QoSProfile
 from rosgraph import NodeProcess, spin_until, start_rclpy
+from std_srvs.srv import Trigger
 
-rclpy = pytest.importorskip("rclpy")
-
-from diagnostic_msgs.srv import AddDiagnostics  # noqa: E402
-from geometry_msgs.msg import Twist  # noqa: E402
-from nav_msgs.srv import GetMap, GetPlan  # noqa: E402
-from std_srvs.srv import Trigger  # noqa: E402
-
-from ravh_msgs_py import names as n  # noqa: E402
-from ravh_msgs_py.query import QUERIES  # noqa: E402
+from ravh_msgs_py import names as n
+from ravh_msgs_py.query import QUERIES
 
 WORDS = ["Door_0", "Door_1", "Bed_0", "Chair_0", "Light_0", "Bedroom_1", "Bathroom_1", "all", "ceiling",
          "lamps", "random", "on", "off", "open", "closed", "walls", "floor", "brick", "#ff0000", "night"]
@@ -55,18 +55,21 @@ cheap_appearance = st.fixed_dictionaries({}, optional={
 
 @pytest.fixture(scope="module")
 def node():
-    proc = NodeProcess("sim", "--house", "20", "--camera-rate", "0")
-    start_rclpy()
-    probe = rclpy.create_node("fuzzer")
-    clients = {name: probe.create_client(AddDiagnostics, name) for name in (n.QUERY_SERVICE, n.APPEARANCE_SERVICE)}
-    clients.update({n.GET_PLAN_SERVICE: probe.create_client(GetPlan, n.GET_PLAN_SERVICE),
-                    n.GET_MAP_SERVICE: probe.create_client(GetMap, n.GET_MAP_SERVICE),
-                    n.RESET_SERVICE: probe.create_client(Trigger, n.RESET_SERVICE),
-                    n.CAPTURE_SERVICE: probe.create_client(Trigger, n.CAPTURE_SERVICE)})
-    assert all(c.wait_for_service(timeout_sec=90) for c in clients.values()), proc.log()[-2000:]
-    yield proc, probe, clients, probe.create_publisher(Twist, n.CMD_VEL, 10)
-    probe.destroy_node()
-    assert proc.stop() == 0, proc.log()[-3000:]
+    with NodeProcess("sim", "--house", "20", "--camera-rate", "0") as proc:
+        start_rclpy()
+        probe = rclpy.create_node("fuzzer")
+        try:
+            clients = {name: probe.create_client(AddDiagnostics, name)
+                       for name in (n.QUERY_SERVICE, n.APPEARANCE_SERVICE)}
+            clients.update({n.GET_PLAN_SERVICE: probe.create_client(GetPlan, n.GET_PLAN_SERVICE),
+                            n.GET_MAP_SERVICE: probe.create_client(GetMap, n.GET_MAP_SERVICE),
+                            n.RESET_SERVICE: probe.create_client(Trigger, n.RESET_SERVICE),
+                            n.CAPTURE_SERVICE: probe.create_client(Trigger, n.CAPTURE_SERVICE)})
+            assert all(c.wait_for_service(timeout_sec=90) for c in clients.values()), proc.log()[-2000:]
+            yield proc, probe, clients, probe.create_publisher(Twist, n.CMD_VEL, 10)
+        finally:
+            probe.destroy_node()
+        assert proc.stop() == 0, proc.log()[-3000:]
     assert "Traceback" not in proc.log()
 
 
@@ -108,11 +111,28 @@ def test_random_appearance_changes_get_envelopes(node, req):
 @FUZZ
 @given(v=st.floats(allow_nan=True, allow_infinity=True), w=st.floats(allow_nan=True, allow_infinity=True))
 def test_random_velocities_never_hurt(node, v, w):
-    _, probe, _, cmd = node
+    proc, probe, _, cmd = node
     msg = Twist()
     msg.linear.x, msg.angular.z = v, w
     cmd.publish(msg)
     rclpy.spin_once(probe, timeout_sec=0)
+    assert proc.alive(), proc.log()[-3000:]
+
+
+def test_after_random_velocities_the_robot_is_whole_and_inside_the_house(node):
+    """What the velocities above did: the robot's true pose is finite and inside a room of house 20."""
+    _, probe, clients, cmd = node
+    cmd.publish(Twist())
+    poses: list[PoseStamped] = []
+    sub = probe.create_subscription(PoseStamped, n.GROUND_TRUTH_POSE, poses.append, QoSProfile(depth=10))
+    try:
+        assert spin_until(probe, lambda: len(poses) >= 3, 60)
+    finally:
+        probe.destroy_subscription(sub)
+    p, q = poses[-1].pose.position, poses[-1].pose.orientation
+    assert all(math.isfinite(v) for v in (p.x, p.y, p.z, q.z, q.w))
+    room = call(probe, clients[n.QUERY_SERVICE], json.dumps({"query": "room_at", "x": p.x, "y": p.y}))
+    assert room["ok"] and room["result"] is not None, (p.x, p.y)
 
 
 @settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)

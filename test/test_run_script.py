@@ -1,9 +1,9 @@
 """tools/run.sh: arguments checked before anything starts; one process ending stops them all."""
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
-import time
 from pathlib import Path
 
 import pytest
@@ -41,19 +41,30 @@ def _children(pid: int) -> dict[int, str]:
 
 
 def test_when_the_behaviour_ends_the_sim_is_stopped_too(tmp_path):
+    import rclpy
+    from rosgraph import spin_until, start_rclpy
+
+    from ravh_msgs_py import names as n
     run = subprocess.Popen(["bash", RUN, "--house", "20", "--rtf", "0"], env=ros_env(), cwd=tmp_path,
-                           stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                           stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    start_rclpy()
+    node = rclpy.create_node("run_script_probe")
     try:
-        end = time.monotonic() + 300
-        while len(_children(run.pid)) < 2 and time.monotonic() < end:
-            time.sleep(0.5)
+        # both up and running: the sim serves /clock, the wanderer drives cmd_vel
+        up = spin_until(node, lambda: node.count_publishers("/" + n.CMD_VEL) >= 1
+                        and node.count_publishers(n.CLOCK) >= 1 and len(_children(run.pid)) >= 2, 300)
+        assert up, "run.sh did not start the sim and the wanderer"
         children = _children(run.pid)
         behaviour = next(pid for pid, cmd in children.items() if "wanderer" in cmd)
-        time.sleep(5)                                          # both up and running
-        subprocess.run(["kill", "-INT", str(behaviour)], check=True)
+        subprocess.run(["kill", "-INT", str(behaviour)], check=True, timeout=30)
         run.wait(timeout=60)
         assert not any(Path(f"/proc/{pid}").exists() for pid in children)
     finally:
+        node.destroy_node()
         if run.poll() is None:
-            run.send_signal(signal.SIGINT)
-            run.wait(timeout=60)
+            os.killpg(run.pid, signal.SIGINT)                 # the script and everything it started
+            try:
+                run.wait(timeout=60)
+            except subprocess.TimeoutExpired:
+                os.killpg(run.pid, signal.SIGKILL)
+                run.wait()

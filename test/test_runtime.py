@@ -43,15 +43,28 @@ def test_commands_are_validated(runtime):
     runtime.command(agent, 0.0, 0.0)
 
 
-def test_map_to_odom_composes_with_odometry_to_the_true_pose(runtime):
-    from ravh_sim.poses import compose
+def _matrix(pose) -> np.ndarray:
+    x, y, yaw = pose
+    return np.array([[math.cos(yaw), -math.sin(yaw), x], [math.sin(yaw), math.cos(yaw), y], [0.0, 0.0, 1.0]])
+
+
+def test_map_to_odom_follows_the_odometry_drift_to_the_true_pose(runtime):
+    """Odometry drifts (the profile's 6 cm/m, 1°/rad), so map -> odom must move by that drift: applied to
+    the odometry it gives the true pose. Checked with homogeneous matrices, not with poses.compose."""
     agent = runtime.agents[0]
+    runtime.step()
+    m0, odom0, true0 = runtime.map_to_odom(agent), agent.robot.odometry, agent.robot.pose
+    assert np.allclose(_matrix(m0) @ _matrix(odom0), _matrix(true0), atol=1e-9)
     runtime.command(agent, 0.2, 0.3)
     runtime.step(480)
     runtime.command(agent, 0.0, 0.0)
-    x, y, yaw = compose(runtime.map_to_odom(agent), agent.robot.odometry)
-    tx, ty, tyaw = agent.robot.pose
-    assert (x, y) == pytest.approx((tx, ty), abs=1e-9) and math.cos(yaw - tyaw) == pytest.approx(1.0)
+    m1, odom1, true1 = runtime.map_to_odom(agent), agent.robot.odometry, agent.robot.pose
+    true_motion = np.linalg.inv(_matrix(true0)) @ _matrix(true1)
+    odom_motion = np.linalg.inv(_matrix(odom0)) @ _matrix(odom1)
+    assert np.abs(true_motion[:2, 2]).max() > 0.01                     # the robot drove
+    assert not np.allclose(true_motion, odom_motion, atol=1e-4)        # and its odometry drifted
+    assert np.allclose(_matrix(m1) @ _matrix(odom1), _matrix(true1), atol=1e-9)
+    assert 1e-5 < math.dist(m1[:2], m0[:2]) < 0.2
 
 
 def test_optical_frame_rotation_is_rep103():
@@ -166,11 +179,12 @@ HUGE = "x" * 10_000_000
 
 @pytest.mark.parametrize("x", EXTREMES)
 def test_plans_to_extreme_points_are_refused(runtime, x):
+    """Every extreme is far outside house 20 (or not a number, or 5e-324/-0.0 at the origin, which is
+    outside its free space too): each plan is refused with one line."""
     for start, goal in (((x, 0.0), (0.0, 0.0)), ((-3.0, 1.6), (x, x))):
-        try:
+        with pytest.raises(UserError) as refused:
             runtime.plan(start, goal)
-        except UserError as e:
-            assert "\n" not in str(e)
+        assert "\n" not in str(refused.value)
 
 
 @pytest.mark.parametrize("x", EXTREMES)

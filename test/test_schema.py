@@ -8,6 +8,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import json
+import math
 
 import pytest
 import yaml
@@ -21,6 +22,9 @@ from ravh_sim.world.house import load_house
 from ravh_sim.world.settings import SEED_MAX, load_settings, resolve
 
 NOT_UTF8 = b"seed: \xff\xfe\n"
+# a "billion laughs": nine levels of ten aliases each, 4 KB that a YAML loader would expand to 10^9 nodes
+LAUGHS = 'a: &a ["lol","lol","lol","lol","lol","lol","lol","lol","lol","lol"]\n' + "".join(
+    f"{b}: &{b} [{', '.join(['*' + a] * 10)}]\n" for a, b in zip("abcdefgh", "bcdefghi"))
 
 
 def _one_line(err: Exception, path) -> str:
@@ -49,6 +53,11 @@ def _one_line(err: Exception, path) -> str:
     ("agents: [{start: [1, nan, 0]}]\n", "agents[0].start"),
     ("agents: 3\n", "agents"),
     ("lihgts: {}\n", "lihgts"),
+    (LAUGHS + "seed: *i\n", "line 2 column 8"),             # billion laughs: refused at the first alias
+    (LAUGHS + "agents: [{start: *i}]\n", "line 2 column 8"),
+    (LAUGHS + "lights: {set: *i}\n", "line 2 column 8"),
+    ("agents: [" + "{}, " * 33 + "]\n", "agents"),
+    ("seed: 1\n" + "#" * (1 << 20) + "\n", "(file)"),                   # over 1 MiB
 ])
 def test_bad_settings_file_fields(tmp_path, text, field):
     path = tmp_path / "s.yaml"
@@ -63,6 +72,7 @@ def test_bad_settings_file_fields(tmp_path, text, field):
     ("models: {all: 99}\n", "models.all"),                    # no object has 99 models (used to wrap)
     ("agents: [{start: [1000, 1000, 0]}]\n", "agents[0].start"),
     ("agents: [{name: a}, {name: b}]\n", "agents[1].start"),  # both on the station
+    ("agents: [{name: robot}, {name: ravh, start: [-1.5, 1.5, 0]}]\n", "agents[1].name"),   # ravh/... is the sim's
 ])
 def test_settings_that_need_the_house(houses, tmp_path, text, field):
     path = tmp_path / "s.yaml"
@@ -119,6 +129,8 @@ def _set(d: dict, dotted: str, value) -> None:
     ("camera.effects.blurr", True, "camera.effects.blurr"),
     ("wheels", 4, "wheels"),
     ("laser", None, "laser"),
+    ("laser.resolution", 0.01, "laser"),                      # 36,000 rays: over pybullet's batch of 16,384
+    ("camera.near", 1e-300, "camera.near"),                   # a singular projection
 ])
 def test_bad_profile_fields(tmp_path, key, value, field):
     data = yaml.safe_load((ROBOTS_DIR / "giraff.yaml").read_text())
@@ -128,6 +140,15 @@ def test_bad_profile_fields(tmp_path, key, value, field):
     with pytest.raises(FileFieldError) as err:
         load_profile(path)
     assert err.value.field == field
+    _one_line(err.value, path)
+
+
+def test_a_profile_with_aliases_is_refused_at_the_alias(tmp_path):
+    path = tmp_path / "bot.yaml"
+    path.write_text(LAUGHS + (ROBOTS_DIR / "giraff.yaml").read_text().replace("name: giraff", "name: *i"))
+    with pytest.raises(FileFieldError, match="aliases") as err:
+        load_profile(path)
+    assert err.value.field.startswith("line ")
     _one_line(err.value, path)
 
 
@@ -147,6 +168,16 @@ def test_profile_effects_schema_covers_camera_options():
 HOUSE20 = json.loads((HOUSES_DIR / "house20.json").read_text())
 
 
+def _circle(count: int) -> list[list[float]]:
+    """A simple polygon of ``count`` vertices around the middle of house 20."""
+    angles = (2 * math.pi * k / count for k in range(count))
+    return [[-2.0 + 1.5 * math.cos(t), 1.0 + 1.5 * math.sin(t)] for t in angles]
+
+
+def _copies(obj: dict, count: int) -> list[dict]:
+    return [{**obj, "id": f"{obj['id']}_{k}"} for k in range(count)]
+
+
 @pytest.mark.parametrize("mutate, field", [
     (lambda d: d["rooms"][0].__setitem__("floor", [[0, 0], [2, 2], [2, 0], [0, 2]]), "rooms[0].floor"),
     (lambda d: d["rooms"][0].__setitem__("floor", [[0, 0], [1, 1], [2, 2]]), "rooms[0].floor"),
@@ -163,6 +194,22 @@ HOUSE20 = json.loads((HOUSES_DIR / "house20.json").read_text())
     (lambda d: d.__setitem__("house", 21), "house"),                      # the file is house20.json
     (lambda d: d.__setitem__("house", "20"), "house"),
     (lambda d: d["objects"][0].__setitem__("default_open", 1), "objects[0].default_open"),
+    (lambda d: d["rooms"][0].__setitem__("floor", _circle(10_000)), "rooms[0].floor"),
+    (lambda d: d.__setitem__("objects", _copies(d["objects"][4], 80_000)), "(file)"),          # 30 MB
+    (lambda d: d.__setitem__("objects", _copies(d["objects"][4], 2_001)), "objects"),
+    (lambda d: d["lights"][1].__setitem__("id", d["lights"][0]["id"]), "lights[1].id"),
+    (lambda d: d["doors"][1].__setitem__("id", d["doors"][0]["id"]), "doors[1].id"),
+    (lambda d: d["windows"][1].__setitem__("id", d["windows"][0]["id"]), "windows[1].id"),
+    (lambda d: d["objects"][4]["models"][0].__setitem__("position", [400.0, 0.0, 0.5]), "objects[4].models[0]"),
+    (lambda d: d["doors"][0].__setitem__("position", [-300.0, 0.0, 1.0]), "doors[0].position"),
+    (lambda d: d["lights"][0].__setitem__("position", [0.0, 500.0, 2.5]), "lights[0].position"),
+    (lambda d: d["objects"][4]["models"][0].__setitem__("size", [99.0, 99.0, 1.0]), "objects[4].models[0]"),
+    (lambda d: d["rooms"][0].update(floor_z=-999.0, ceiling_z=999.0), "rooms[0]"),                 # 2 km tall
+    (lambda d: d.__setitem__("walls", []), "walls"),
+    (lambda d: d["objects"][4].__setitem__("id", "Bed\x00"), "objects[4].id"),
+    (lambda d: d["rooms"][0].__setitem__("name", "Kitchen\nroom"), "rooms[0].name"),
+    (lambda d: d["lights"][0].__setitem__("id", "\x1b[31mLight"), "lights[0].id"),
+    (lambda d: d["rooms"][1].__setitem__("floor", d["rooms"][0]["floor"][::-1]), "rooms[1].floor"),
 ])
 def test_bad_house_fields(tmp_path, mutate, field):
     data = copy.deepcopy(HOUSE20)

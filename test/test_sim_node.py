@@ -7,27 +7,28 @@ import time
 
 import numpy as np
 import pytest
+import rclpy
+from diagnostic_msgs.srv import AddDiagnostics
+from geometry_msgs.msg import PoseStamped, TransformStamped, Twist
+from nav_msgs.msg import OccupancyGrid, Odometry
+from nav_msgs.srv import GetMap, GetPlan
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from rosgraph import NodeProcess, spin_until, start_rclpy
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import CameraInfo, CompressedImage, Image, LaserScan
+from std_msgs.msg import String
+from std_srvs.srv import Trigger
 
-rclpy = pytest.importorskip("rclpy")
-
-from diagnostic_msgs.srv import AddDiagnostics  # noqa: E402
-from geometry_msgs.msg import PoseStamped, TransformStamped, Twist  # noqa: E402
-from nav_msgs.msg import OccupancyGrid, Odometry  # noqa: E402
-from nav_msgs.srv import GetMap, GetPlan  # noqa: E402
-from rosgraph_msgs.msg import Clock  # noqa: E402
-from sensor_msgs.msg import CameraInfo, CompressedImage, Image, LaserScan  # noqa: E402
-from std_msgs.msg import String  # noqa: E402
-from std_srvs.srv import Trigger  # noqa: E402
-
-from ravh_msgs_py import names as n  # noqa: E402
-from ravh_msgs_py.capture import CaptureEvent  # noqa: E402
-from ravh_msgs_py.client import RavhClient  # noqa: E402
-from ravh_sim.nav.grid import FREE  # noqa: E402
-from ravh_sim.nodes import convert  # noqa: E402
-from ravh_sim.nodes.common import LATCHED_QOS, SENSOR_QOS, STATE_QOS  # noqa: E402
+from ravh_msgs_py import names as n
+from ravh_msgs_py.capture import CaptureEvent
+from ravh_msgs_py.client import RavhClient
+from ravh_sim.nav.grid import FREE
+from ravh_sim.nodes import convert
+from ravh_sim.nodes.common import LATCHED_QOS, SENSOR_QOS, STATE_QOS
 
 HOUSE = "20"
+# REP 2003: map clients subscribe reliable and transient-local
+REP2003_MAP = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 TOPICS = {   # topic: (type, qos, expected frame_id or None)
     n.CLOCK: (Clock, STATE_QOS, None),
     n.SCAN: (LaserScan, SENSOR_QOS, n.LASER_FRAME),
@@ -83,13 +84,15 @@ class Probe:
 
 @pytest.fixture(scope="module")
 def sim():
-    proc = NodeProcess("sim", "--house", HOUSE, "--seed", "0")
-    probe = Probe()
-    ok = spin_until(probe.node, lambda: len(probe.got[n.COLOR_IMAGE]) >= 3 and probe.got[n.GROUND_TRUTH], 90)
-    assert ok, f"sim did not publish images:\n{proc.log()[-3000:]}"
-    yield proc, probe
-    probe.close()
-    code = proc.stop()
+    with NodeProcess("sim", "--house", HOUSE, "--seed", "0") as proc:
+        probe = Probe()
+        try:
+            ok = spin_until(probe.node, lambda: len(probe.got[n.COLOR_IMAGE]) >= 3 and probe.got[n.GROUND_TRUTH], 90)
+            assert ok, f"sim did not publish images:\n{proc.log()[-3000:]}"
+            yield proc, probe
+        finally:
+            probe.close()
+        code = proc.stop()
     assert code == 0, f"sim did not stop cleanly on SIGINT (exit {code}):\n{proc.log()[-3000:]}"
     assert "Traceback" not in proc.log()
 
@@ -110,14 +113,22 @@ def test_every_topic_has_its_type_and_frame(sim):
 
 
 def test_rates_in_sim_time(sim):
+    """Messages per second of sim time, counted by the publisher's sequence numbers: a subscriber
+    starved on a loaded machine may drop messages, but the numbers of those it gets still count them."""
     _, probe = sim
-    for topic in RATES:
-        probe.got[topic].clear()
-    assert spin_until(probe.node, lambda: all(len(probe.got[t]) >= 10 for t in RATES), 60)
+    seen: dict[str, list[tuple[float, int]]] = {t: [] for t in RATES}
+    subs = [probe.node.create_subscription(
+        TOPICS[t][0], t, lambda m, info, t=t: seen[t].append((stamp_s(m), info["publication_sequence_number"])),
+        TOPICS[t][1]) for t in RATES]
+    try:
+        assert spin_until(probe.node, lambda: all(len(v) >= 2 and v[-1][0] - v[0][0] >= 2.0 for v in seen.values()),
+                          120)
+    finally:
+        for sub in subs:
+            probe.node.destroy_subscription(sub)
     for topic, rate in RATES.items():
-        stamps = [stamp_s(m) for m in probe.got[topic]]
-        measured = (len(stamps) - 1) / (stamps[-1] - stamps[0])
-        assert measured == pytest.approx(rate, rel=0.1), topic
+        (t0, seq0), (t1, seq1) = seen[topic][0], seen[topic][-1]
+        assert (seq1 - seq0) / (t1 - t0) == pytest.approx(rate, rel=0.1), topic
 
 
 def test_one_capture_shares_one_stamp(sim):
@@ -245,22 +256,160 @@ def test_appearance_change_alters_the_next_image(sim):
     probe.call(AddDiagnostics, n.APPEARANCE_SERVICE, AddDiagnostics.Request(load_namespace='{"sun_angle": "day"}'))
 
 
+def gt_pose(probe) -> tuple[float, float, float]:
+    return convert.pose_of(probe.got[n.GROUND_TRUTH_POSE][-1].pose)
+
+
+def sim_time(probe) -> float:
+    return stamp_s(probe.got[n.CLOCK][-1])
+
+
+def subscribe(probe, kind, topic: str, qos) -> list:
+    """Messages of ``topic``, once the subscription has matched the sim's publisher."""
+    got: list = []
+    sub = probe.node.create_subscription(kind, topic, got.append, qos)
+    assert spin_until(probe.node, lambda: sub.get_publisher_count() >= 1, 30), topic
+    return got
+
+
+def still(probe, sim_seconds: float) -> tuple[float, float, float]:
+    """Wait until sim time has run ``sim_seconds`` on; the ground-truth pose then."""
+    until = sim_time(probe) + sim_seconds
+    assert spin_until(probe.node, lambda: stamp_s(probe.got[n.GROUND_TRUTH_POSE][-1]) > until, 60)
+    return gt_pose(probe)
+
+
 def test_capture_service_publishes_now(sim):
+    """The reply's stamp is a capture that went out: the event, an image, a depth image and a scan of it."""
     _, probe = sim
+    events = subscribe(probe, String, n.CAPTURE_EVENT, QoSProfile(depth=10))
     reply = probe.call(Trigger, n.CAPTURE_SERVICE, Trigger.Request())
     event = CaptureEvent.from_json(reply.message)
     assert reply.success and event.room and event.agent == n.DEFAULT_AGENT and len(event.pose) == 3
 
+    def published(topic: str) -> bool:
+        return any(stamp_s(m) == pytest.approx(event.stamp, abs=1e-6) for m in probe.got[topic])
+    assert spin_until(probe.node, lambda: any(CaptureEvent.from_json(m.data).stamp == event.stamp for m in events)
+                      and all(published(t) for t in (n.COLOR_IMAGE, n.DEPTH_IMAGE, n.SCAN)), 30)
+
 
 def test_bad_velocities_are_refused_with_a_warning(sim):
+    """NaN, inf and 1e9 m/s are refused (logged) and do not move the robot."""
     proc, probe = sim
+    before = still(probe, 1.0)                        # at rest: the command timeout stopped earlier turns
     for bad in (float("nan"), float("inf"), 1e9):
         t = Twist()
         t.linear.x = bad
         probe.cmd.publish(t)
-    probe.spin(1.0)
+    assert spin_until(probe.node, lambda: "rejected" in proc.log(), 30)
+    after = still(probe, 1.0)
     assert proc.alive()
-    assert "rejected" in proc.log()
+    assert all(math.isfinite(v) for v in after) and math.dist(before[:2], after[:2]) < 1e-3
+
+
+def test_commands_stop_half_a_second_after_the_last_one(sim):
+    """A robot whose cmd_vel stops is stopped CMD_TIMEOUT_S (0.5 s of sim time) later: it turns while
+    commanded, then its heading holds still."""
+    _, probe = sim
+    start = still(probe, 0.2)
+    turn = Twist()
+    turn.angular.z = 0.5
+    end = time.monotonic() + 60
+    while abs(math.remainder(gt_pose(probe)[2] - start[2], 2 * math.pi)) < 0.2 and time.monotonic() < end:
+        probe.cmd.publish(turn)
+        spin_until(probe.node, lambda: False, 0.05)
+    last_command = sim_time(probe)              # the sim got the last command at this sim time or later
+    assert spin_until(probe.node, lambda: stamp_s(probe.got[n.GROUND_TRUTH_POSE][-1]) > last_command + 4.0, 120)
+
+    def headings(t0: float, t1: float) -> list[float]:
+        return [convert.pose_of(m.pose)[2] for m in probe.got[n.GROUND_TRUTH_POSE]
+                if last_command + t0 <= stamp_s(m) <= last_command + t1]
+    early, late = headings(0.05, 0.45), headings(2.0, 4.0)
+    assert len(early) >= 5 and abs(math.remainder(early[-1] - early[0], 2 * math.pi)) > 0.05   # still turning
+    assert len(late) >= 10 and max(late) - min(late) < 1e-3                                  # stopped
+
+
+def test_map_is_republished_when_a_door_changes(sim):
+    """Closing a door is an obstacle on the next /map: the map changes where the door is, and opening it
+    again gives the first map back."""
+    _, probe = sim
+    maps = subscribe(probe, OccupancyGrid, n.MAP, REP2003_MAP)
+    assert spin_until(probe.node, lambda: bool(maps), 10)
+    door = json.loads(probe.call(AddDiagnostics, n.QUERY_SERVICE, AddDiagnostics.Request(
+        load_namespace='{"query": "door", "id": "Door_0"}')).message)["result"]
+    first = convert.grid_of(maps[-1])
+    flip = "closed" if door["open"] else "open"
+    for state, count in ((flip, 2), ("open" if flip == "closed" else "closed", 3)):
+        reply = probe.call(AddDiagnostics, n.APPEARANCE_SERVICE,
+                           AddDiagnostics.Request(load_namespace=json.dumps({"doors": {"Door_0": state}})))
+        assert reply.success, reply.message
+        assert spin_until(probe.node, lambda c=count: len(maps) >= c, 30), f"no /map after Door_0 {state}"
+    changed, back = convert.grid_of(maps[1]), convert.grid_of(maps[2])
+    differ = np.argwhere(changed.data != first.data)
+    assert len(differ) > 0 and np.array_equal(back.data, first.data)
+    x, y = door["position"][:2]
+    assert min(math.dist((x, y), changed.center_of(r, c)) for r, c in differ) < door["width"]
+
+
+def test_free_space_is_the_obstacle_map_shrunk_by_the_robot(sim):
+    """/ravh/free_space (latched) is the GetFreeSpace map; every free cell of it is free on /map, it is
+    smaller (inflated by the robot's radius), and the robot stands in it."""
+    _, probe = sim
+    free = subscribe(probe, OccupancyGrid, n.FREE_SPACE_MAP, REP2003_MAP)
+    maps = subscribe(probe, OccupancyGrid, n.MAP, REP2003_MAP)
+    assert spin_until(probe.node, lambda: bool(free) and bool(maps), 10)
+    assert free[-1].header.frame_id == n.MAP_FRAME
+    grid, obstacles = convert.grid_of(free[-1]), convert.grid_of(maps[-1])
+    served = convert.grid_of(probe.call(GetMap, n.GET_FREE_SPACE_SERVICE, GetMap.Request()).map)
+    assert np.array_equal(grid.data, served.data)
+    assert grid.data.shape == obstacles.data.shape and grid.origin == pytest.approx(obstacles.origin)
+    assert np.all(obstacles.data[grid.data == FREE] == FREE)
+    assert 0.3 * (obstacles.data == FREE).sum() < (grid.data == FREE).sum() < 0.95 * (obstacles.data == FREE).sum()
+    assert grid.is_free(*gt_pose(probe)[:2])
+
+
+def test_reset_puts_the_robot_back_and_undoes_appearance(sim):
+    """/ravh/reset: the robot is back at its start pose (the footprint's), a closed door is as the
+    settings say again."""
+    _, probe = sim
+    footprint = json.loads(probe.got[n.GROUND_TRUTH][-1].data)
+    start = footprint["settings"]["agents"][0]["pose"]
+    initial_door = footprint["settings"]["doors"]["Door_1"]
+    changed = "closed" if initial_door else "open"
+    assert probe.call(AddDiagnostics, n.APPEARANCE_SERVICE, AddDiagnostics.Request(
+        load_namespace=json.dumps({"doors": {"Door_1": changed}}))).success
+    forward = Twist()
+    forward.angular.z = 0.5
+    end = time.monotonic() + 60
+    while abs(math.remainder(gt_pose(probe)[2] - start[2], 2 * math.pi)) < 0.3 and time.monotonic() < end:
+        probe.cmd.publish(forward)
+        spin_until(probe.node, lambda: False, 0.05)
+    assert abs(math.remainder(gt_pose(probe)[2] - start[2], 2 * math.pi)) >= 0.3    # away from the start
+    assert probe.call(Trigger, n.RESET_SERVICE, Trigger.Request()).success
+    x, y, yaw = still(probe, 0.2)
+    assert math.dist((x, y), start[:2]) < 0.01 and abs(math.remainder(yaw - start[2], 2 * math.pi)) < 0.01
+    door = json.loads(probe.call(AddDiagnostics, n.QUERY_SERVICE, AddDiagnostics.Request(
+        load_namespace='{"query": "door", "id": "Door_1"}')).message)["result"]
+    assert door["open"] == initial_door
+
+
+def test_qos_offered_follows_rep_2003(sim):
+    """What the sim offers, read from the graph and compared with REP 2003's values (not with the
+    node's own constants): sensor data reliable and volatile (SystemDefaultsQoS), so both sensor-data
+    (best-effort) and reliable subscribers match; maps and other latched data reliable and
+    transient-local, so late joiners get them. A best-effort SensorDataQoS subscriber gets scans."""
+    _, probe = sim
+    expected = {**{t: ("RELIABLE", "VOLATILE") for t in (n.SCAN, n.COLOR_IMAGE, n.DEPTH_IMAGE, n.INSTANCE_IMAGE,
+                                                      n.COLOR_INFO, n.ODOM)},
+                **{t: ("RELIABLE", "TRANSIENT_LOCAL") for t in (n.MAP, n.FREE_SPACE_MAP, n.TF_STATIC,
+                                                             n.GROUND_TRUTH)}}
+    for topic, (reliability, durability) in expected.items():
+        name = topic if topic.startswith("/") else "/" + topic
+        offered = [i.qos_profile for i in probe.node.get_publishers_info_by_topic(name)]
+        assert offered, topic
+        assert {(q.reliability.name, q.durability.name) for q in offered} == {(reliability, durability)}, topic
+    scans = subscribe(probe, LaserScan, n.SCAN, qos_profile_sensor_data)
+    assert spin_until(probe.node, lambda: len(scans) >= 3, 30)
 
 
 def test_oversized_requests_are_refused_and_not_kept(sim):

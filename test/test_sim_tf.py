@@ -12,23 +12,21 @@ from collections import deque
 import cv2
 import numpy as np
 import pytest
+import rclpy
+from geometry_msgs.msg import PoseStamped, TransformStamped
+from nav_msgs.msg import OccupancyGrid
+from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
+from rcl_interfaces.srv import SetParameters
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph import NodeProcess, spin_until, start_rclpy
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import Image, LaserScan
+from tf2_msgs.msg import TFMessage
 
-rclpy = pytest.importorskip("rclpy")
-
-from geometry_msgs.msg import PoseStamped, TransformStamped  # noqa: E402
-from nav_msgs.msg import OccupancyGrid  # noqa: E402
-from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue  # noqa: E402
-from rcl_interfaces.srv import SetParameters  # noqa: E402
-from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
-from rosgraph_msgs.msg import Clock  # noqa: E402
-from sensor_msgs.msg import Image, LaserScan  # noqa: E402
-from tf2_msgs.msg import TFMessage  # noqa: E402
-
-from ravh_msgs_py import names as n  # noqa: E402
-from ravh_sim.nav.grid import FREE, OCCUPIED  # noqa: E402
-from ravh_sim.nodes import convert  # noqa: E402
-from ravh_sim.nodes.common import LATCHED_QOS, SENSOR_QOS, STATE_QOS  # noqa: E402
+from ravh_msgs_py import names as n
+from ravh_sim.nav.grid import FREE, OCCUPIED
+from ravh_sim.nodes import convert
+from ravh_sim.nodes.common import LATCHED_QOS, SENSOR_QOS, STATE_QOS
 
 CONFIG = """agents:
   - {name: robot, profile: giraff, start: station}
@@ -96,20 +94,23 @@ class Watcher:
 def sim(tmp_path_factory):
     cfg = tmp_path_factory.mktemp("tf") / "two.yaml"
     cfg.write_text(CONFIG)
-    proc = NodeProcess("sim", "--house", "20", "--seed", "0", "--config", str(cfg), "--camera-rate", "3",
-                       "--scan-rate", "7")          # rates whose periods fall between /clock ticks
-    watcher = Watcher()
-    ok = spin_until(watcher.node, lambda: all(watcher.sensors.values()) and watcher.map_odom(), 90)
-    assert ok, f"sim did not start:\n{proc.log()[-3000:]}"
-    yield proc, watcher
-    watcher.node.destroy_node()
-    assert proc.stop() == 0, proc.log()[-3000:]
+    with NodeProcess("sim", "--house", "20", "--seed", "0", "--config", str(cfg), "--camera-rate", "3",
+                     "--scan-rate", "7") as proc:          # rates whose periods fall between /clock ticks
+        watcher = Watcher()
+        try:
+            ok = spin_until(watcher.node, lambda: all(watcher.sensors.values()) and watcher.map_odom(), 90)
+            assert ok, f"sim did not start:\n{proc.log()[-3000:]}"
+            yield proc, watcher
+        finally:
+            watcher.node.destroy_node()
+        assert proc.stop() == 0, proc.log()[-3000:]
     assert "Traceback" not in proc.log()
 
 
 def test_late_joiner_reaches_every_sensor_frame_of_both_agents_from_map(sim):
     _, watcher = sim
-    watcher.spin(2.0)
+    assert spin_until(watcher.node, lambda: {t.child_frame_id for t in watcher.tf}
+                      >= {n.BASE_FRAME, f"robot2/{n.BASE_FRAME}", n.ODOM_FRAME}, 30)
     late = rclpy.create_node(f"late_joiner_{time.monotonic_ns()}")
     statics: list[TFMessage] = []
     late.create_subscription(TFMessage, n.TF_STATIC, statics.append, LATCHED_QOS)
@@ -134,15 +135,21 @@ def test_late_joiner_reaches_every_sensor_frame_of_both_agents_from_map(sim):
 def test_tf_tree_matches_ground_truth(sim):
     """map -> odom -> base_link, composed, is the ground-truth pose of the same stamp."""
     _, watcher = sim
-    watcher.spin(1.0)
-    by_stamp: dict[int, dict[str, TransformStamped]] = {}
-    for t in watcher.tf:
-        by_stamp.setdefault(stamp_ns(t.header.stamp), {})[t.child_frame_id] = t
+
+    def by_stamp() -> dict[int, dict[str, TransformStamped]]:
+        edges: dict[int, dict[str, TransformStamped]] = {}
+        for t in list(watcher.tf):
+            edges.setdefault(stamp_ns(t.header.stamp), {})[t.child_frame_id] = t
+        return edges
+
+    def complete() -> list[tuple[int, dict[str, TransformStamped]]]:
+        tf = by_stamp()
+        return [(stamp, tf[stamp]) for stamp in list(watcher.poses)
+                if {n.ODOM_FRAME, n.BASE_FRAME} <= set(tf.get(stamp, {}))]
+    assert spin_until(watcher.node, lambda: len(complete()) >= 10, 60)
     checked = 0
-    for stamp, pose in watcher.poses.items():
-        edges = by_stamp.get(stamp, {})
-        if n.ODOM_FRAME not in edges or n.BASE_FRAME not in edges:
-            continue
+    for stamp, edges in complete():
+        pose = watcher.poses[stamp]
         (mx, my, myaw), (ox, oy, oyaw) = (_pose2d(edges[f].transform) for f in (n.ODOM_FRAME, n.BASE_FRAME))
         x = mx + ox * math.cos(myaw) - oy * math.sin(myaw)
         y = my + ox * math.sin(myaw) + oy * math.cos(myaw)
@@ -163,8 +170,7 @@ def test_no_stamp_is_ahead_of_the_clock(sim):
     and on a loaded machine a /clock sent before an image can arrive after it."""
     _, watcher = sim
     watcher.arrivals.clear()
-    watcher.spin(3.0)
-    assert len(watcher.arrivals) >= 20
+    assert spin_until(watcher.node, lambda: len(watcher.arrivals) >= 20, 60)
     late_clocks = [stamp for stamp, clock in watcher.arrivals if stamp > clock]
     spin_until(watcher.node, lambda: all(s in watcher.clocks for s in late_clocks), 5)
     ahead = [s for s, _ in watcher.arrivals if s not in watcher.clocks]
@@ -174,9 +180,14 @@ def test_no_stamp_is_ahead_of_the_clock(sim):
 def test_map_tf_auto_yields_to_a_slam_node_and_takes_over_again(sim):
     proc, watcher = sim
     watcher.slam_on = True
-    watcher.spin(3.0)
+    end = time.monotonic() + 60
+    while "another node publishes map -> odom" not in proc.log() and time.monotonic() < end:
+        watcher.spin(0.1)                            # SLAM's edges go out while the sim notices them
+    assert "another node publishes map -> odom" in proc.log(), proc.log()[-3000:]
     watcher.tf.clear()
-    watcher.spin(3.0)
+    end = time.monotonic() + 60
+    while len(watcher.map_odom()) < 30 and time.monotonic() < end:
+        watcher.spin(0.1)
     edges = watcher.map_odom()
     assert len(edges) >= 30
     flips = sum(1 for a, b in zip(edges, edges[1:]) if (a.transform.translation.x == SLAM_X)

@@ -13,16 +13,13 @@ import subprocess
 import sys
 import time
 
-import pytest
-from rosgraph import NodeProcess, remove_orphan_shm, ros_env, spin_until, start_rclpy
+import rclpy
+from diagnostic_msgs.srv import AddDiagnostics
+from rosgraph import NodeProcess, read_line, remove_orphan_shm, ros_env, spin_until, start_rclpy
+from rosgraph_msgs.msg import Clock
 
-rclpy = pytest.importorskip("rclpy")
-
-from diagnostic_msgs.srv import AddDiagnostics  # noqa: E402
-from rosgraph_msgs.msg import Clock  # noqa: E402
-
-from ravh_msgs_py import names as n  # noqa: E402
-from ravh_sim.nodes.common import STATE_QOS  # noqa: E402
+from ravh_msgs_py import names as n
+from ravh_sim.nodes.common import STATE_QOS
 
 BURNERS = 3                    # busy-loop processes: with the sim and this test, ~3x the CPUs of a 2-core box
 CHURN_S = 20.0                 # wall seconds of subscription and client churn (at least MIN_JOINS joins)
@@ -51,10 +48,9 @@ if ok:
 end = time.monotonic() + 10               # the node list fills in as discovery data arrives
 while "ravh_sim" not in node.get_node_names() and time.monotonic() < end:
     rclpy.spin_once(node, timeout_sec=0.05)
+print(json.dumps({"clock": bool(got), "reply": reply, "graph": "ravh_sim" in node.get_node_names()}), flush=True)
 if sys.argv[1] == "hold":
-    print("holding", flush=True)
-    time.sleep(60)
-print(json.dumps({"clock": bool(got), "reply": reply, "graph": "ravh_sim" in node.get_node_names()}))
+    time.sleep(120)                       # until the test SIGKILLs it
 node.destroy_node()
 rclpy.shutdown()
 """
@@ -81,6 +77,7 @@ def test_sim_serves_newcomers_through_churn_and_overload():
     burners = [subprocess.Popen([sys.executable, "-c", burn]) for _ in range(BURNERS)]
     start_rclpy()
     node = rclpy.create_node("soak_probe")
+    killed: list[subprocess.Popen] = []
     try:
         first: list[Clock] = []
         sub = node.create_subscription(Clock, n.CLOCK, first.append, STATE_QOS)
@@ -108,10 +105,11 @@ def test_sim_serves_newcomers_through_churn_and_overload():
                 node.destroy_client(client)
                 calls += 1
         for p in killed:                                          # each subscribed and served, then SIGKILLed
-            lines = iter(p.stdout.readline, "")
-            assert any(line.strip() == "holding" for line in lines), "a held participant was not served"
+            line = read_line(p.stdout, 90)
             p.kill()
             p.wait()
+            assert line and json.loads(line) == {"clock": True, "reply": True, "graph": True}, \
+                f"a held participant was not served: {line!r}"
         waits.sort()
         print(f"soak: {joins} joins, {calls} service clients; first /clock after median "
               f"{waits[len(waits) // 2] * 1000:.0f} ms, max {waits[-1] * 1000:.0f} ms")
@@ -122,7 +120,11 @@ def test_sim_serves_newcomers_through_churn_and_overload():
         for b in burners:
             b.kill()
             b.wait()
+        for p in killed:
+            p.kill()
+            p.wait()
         node.destroy_node()
-        assert proc.stop() == 0, proc.log()[-3000:]
+        code = proc.stop()
         remove_orphan_shm(started)
+    assert code == 0, proc.log()[-3000:]
     assert proc.log().count("Traceback") == 0

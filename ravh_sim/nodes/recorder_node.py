@@ -44,6 +44,7 @@ from rclpy.parameter import Parameter
 from rclpy.publisher import Publisher
 from rclpy.qos import QoSProfile
 from rclpy.serialization import deserialize_message
+from rclpy.subscription import Subscription
 from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
@@ -61,6 +62,7 @@ from ravh_sim.sensors.suite import SENSORS
 
 NS = 1_000_000_000
 PENDING_TIMEOUT_S = 30.0      # wall seconds a stamp's parts wait for the rest of their capture
+MATCHED_LOG = "every capture topic matched the sim's publishers"
 MAX_PENDING = 32              # stamps buffered at most (periodic frames without an event go first)
 
 class Part(NamedTuple):
@@ -211,6 +213,8 @@ class RecorderNode(Node):
         self.failure: str | None = None               # the first write error (the worker thread's)
         self.exit_code = 0
         self.recorded_pub: Publisher | None = None        # made once the agent is known
+        self.part_subs: list[Subscription] = []           # the capture topics, once the agent is known
+        self.matched = False                              # every one of them matched a publisher
         self.log = self.get_logger()
         self.topics: dict[str, str] = {}              # part -> resolved topic name
         for topic, (msg_type, in_dataset) in LATCHED.items():
@@ -248,6 +252,7 @@ class RecorderNode(Node):
             sub = self.create_subscription(part.msg_type, name, lambda d, k=key: self._on_part(k, d), part.qos,
                                            raw=True)
             self.topics[key] = sub.topic_name
+            self.part_subs.append(sub)
             if self.bag and part.bag:
                 self.bag.add_topic(sub.topic_name, part.msg_type, latched=False)
         self.log.info(f"recording agent {agent} of house {footprint['house']} into {self.out}"
@@ -328,7 +333,11 @@ class RecorderNode(Node):
             self.failure = f"{error.strerror}: {error.filename}" if isinstance(error, OSError) else repr(error)
 
     def _check_writes(self) -> None:
-        """A failed write ends the recording loudly (the worker thread cannot raise into the executor)."""
+        """A failed write ends the recording loudly (the worker thread cannot raise into the executor);
+        says once when every capture topic has matched the sim's publisher (what a raid waits for)."""
+        if self.part_subs and not self.matched and all(s.get_publisher_count() > 0 for s in self.part_subs):
+            self.matched = True
+            self.log.info(MATCHED_LOG)
         if self.failure is not None:
             raise UserError(f"dataset write failed ({self.failure}); stopped with {self.captures} captures "
                             f"in {self.out}")

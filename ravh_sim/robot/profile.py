@@ -11,14 +11,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-import yaml
 from pydantic import Field, model_validator
 
 from ravh_msgs_py.names import DEFAULT_PROFILE
-from ravh_sim.errors import FileFieldError, UnknownNameError
+from ravh_sim.errors import UnknownNameError
 from ravh_sim.paths import ROBOTS_DIR
 from ravh_sim.render.backend import QUALITIES
-from ravh_sim.schema import FINITE, Strict, read_text, validate
+from ravh_sim.schema import FINITE, Strict, load_yaml, read_text, validate
 
 
 @dataclass(frozen=True)
@@ -103,6 +102,8 @@ Sigma = Annotated[float, Field(ge=0.0, le=10.0), FINITE]
 Range = Annotated[float, Field(gt=0.0, le=1000.0), FINITE]          # m
 Pixels = Annotated[int, Field(ge=16, le=8192)]
 Coefficient = Annotated[float, Field(ge=-10.0, le=10.0), FINITE]     # of lens distortion
+MAX_RAYS = 16384           # pybullet's rayTestBatch limit: more ends the sim with "Number of rays exceed..."
+MIN_NEAR = 0.001           # m, camera near plane: 1e-300 made the projection matrix singular
 
 
 class _Odometry(Strict):
@@ -126,6 +127,9 @@ class _Laser(Strict):
             raise ValueError(f"range_min {self.range_min} must be below range_max {self.range_max}")
         if self.resolution > self.fov:
             raise ValueError(f"resolution {self.resolution} is wider than fov {self.fov}")
+        if self.fov / self.resolution + 1 > MAX_RAYS:
+            raise ValueError(f"fov {self.fov} / resolution {self.resolution} makes more than {MAX_RAYS} rays "
+                             f"(what pybullet casts in one batch)")
         return self
 
 
@@ -152,7 +156,7 @@ class _Camera(Strict):
     sensor_width: Annotated[float, Field(gt=0.0, le=100.0), FINITE]     # mm
     sensor_height: Annotated[float, Field(gt=0.0, le=100.0), FINITE]
     focal_length: Annotated[float, Field(gt=0.0, le=1000.0), FINITE]
-    near: Range
+    near: Annotated[float, Field(ge=MIN_NEAR, le=1000.0), FINITE]      # m
     far: Range
     rate: Rate
     quality: Literal[QUALITIES] = "realistic"         # type: ignore[valid-type]
@@ -186,10 +190,7 @@ def load_profile(name_or_path: str | Path = DEFAULT_PROFILE) -> RobotProfile:
         path = ROBOTS_DIR / f"{name_or_path}.yaml"
         if not path.exists():
             raise UnknownNameError("robot profile", str(name_or_path), available_profiles())
-    try:
-        data = yaml.safe_load(read_text(path, "robot profile"))
-    except (yaml.YAMLError, RecursionError) as e:
-        raise FileFieldError(path, "(top level)", f"invalid YAML: {type(e).__name__}") from None
+    data = load_yaml(read_text(path, "robot profile"), path)
     f = validate(ProfileFile, data, path)
     lz, cam, effects = f.laser, f.camera, f.camera.effects
     return RobotProfile(

@@ -234,7 +234,7 @@ def load_house(house: int | str | Path, houses_dir: Path = HOUSES_DIR) -> House:
         path = house_path(number, houses_dir)
         if not path.exists():
             raise UnknownNameError("house", number, available_houses(houses_dir))
-    text = read_text(path, "house file")
+    text = read_text(path, "house file", MAX_HOUSE_BYTES)
     try:
         data = json.loads(text)
     except json.JSONDecodeError as e:
@@ -254,7 +254,15 @@ SIZE = 100.0               # m, any object, door or window dimension
 Coord = number(ge=-EXTENT, le=EXTENT)
 Size = number(gt=0.0, le=SIZE)
 Yaw = number(ge=-4 * math.pi, le=4 * math.pi)
-Id = Annotated[str, Field(min_length=1, max_length=200)]
+# no control characters: ids end up in logs, terminals, topic names and file names
+Id = Annotated[str, Field(min_length=1, max_length=200, pattern=r"^[^\x00-\x1f\x7f]+$")]
+# what the geometry may cost: the shipped houses have at most 42 floor vertices, 158 objects, 14 rooms,
+# 27 lights and 3 m rooms; a 10,000-vertex floor or 80,000 objects took minutes to build
+MAX_HOUSE_BYTES = 4 << 20
+MAX_OUTLINE = 256          # vertices of one floor outline
+MAX_ROOM_HEIGHT = 10.0     # m, ceiling above floor
+MAX_ITEMS = {"rooms": 200, "walls": 5000, "doors": 500, "windows": 500, "lights": 1000, "objects": 2000}
+PLAN_MARGIN = 1.0          # m: objects, doors, windows, lights and walls stay this close to the floor plan
 P2 = vector(Coord, 2)
 P3 = vector(Coord, 3)
 
@@ -271,7 +279,7 @@ def _simple_polygon(points: list) -> list:
     return points
 
 
-FloorOutline = Annotated[list[P2], Field(min_length=3, max_length=10_000), AfterValidator(_simple_polygon)]
+FloorOutline = Annotated[list[P2], Field(min_length=3, max_length=MAX_OUTLINE), AfterValidator(_simple_polygon)]
 
 
 class _Room(Strict):
@@ -279,7 +287,7 @@ class _Room(Strict):
     type: Id
     name: Id
     floor: FloorOutline
-    extra_floors: list[FloorOutline] = []
+    extra_floors: Annotated[list[FloorOutline], Field(max_length=16)] = []
     floor_z: Coord
     ceiling_z: Coord
 
@@ -287,6 +295,9 @@ class _Room(Strict):
     def _ceiling_above_floor(self) -> _Room:
         if float(self.ceiling_z) <= float(self.floor_z):      # float(): mypy cannot read Coord as a type
             raise ValueError(f"ceiling_z {self.ceiling_z} must be above floor_z {self.floor_z}")
+        if float(self.ceiling_z) - float(self.floor_z) > MAX_ROOM_HEIGHT:
+            raise ValueError(f"ceiling_z {self.ceiling_z} is more than {MAX_ROOM_HEIGHT:g} m above "
+                             f"floor_z {self.floor_z}")
         return self
 
 
@@ -351,13 +362,13 @@ class _ModelBox(Strict):
 class _Object(Strict):
     id: Id
     type: Id
-    tags: Annotated[list[Id], Field(min_length=1)]
+    tags: Annotated[list[Id], Field(min_length=1, max_length=32)]
     room: Id
     prefab: Id
     yaw: Yaw
     size_estimated: bool
     default_model: Annotated[int, Field(ge=0)]
-    models: Annotated[list[_ModelBox], Field(min_length=1)]
+    models: Annotated[list[_ModelBox], Field(min_length=1, max_length=16)]
     inherits_model_from: Id | None = None
 
     @model_validator(mode="after")
@@ -383,12 +394,12 @@ class HouseFile(Strict):
     attribution: str = ""
     source: dict[str, str] = {}
     station: _Station
-    rooms: Annotated[list[_Room], Field(min_length=1)]
-    walls: list[_Wall]
-    doors: list[_Door]
-    windows: list[_Window]
-    lights: list[_Light]
-    objects: list[_Object]
+    rooms: Annotated[list[_Room], Field(min_length=1, max_length=MAX_ITEMS["rooms"])]
+    walls: Annotated[list[_Wall], Field(min_length=1, max_length=MAX_ITEMS["walls"])]
+    doors: Annotated[list[_Door], Field(max_length=MAX_ITEMS["doors"])]
+    windows: Annotated[list[_Window], Field(max_length=MAX_ITEMS["windows"])]
+    lights: Annotated[list[_Light], Field(max_length=MAX_ITEMS["lights"])]
+    objects: Annotated[list[_Object], Field(max_length=MAX_ITEMS["objects"])]
 
 
 def house_from_dict(data: Any, source: str) -> House:
@@ -396,6 +407,10 @@ def house_from_dict(data: Any, source: str) -> House:
     f = validate(HouseFile, data, source)
     room_ids = _unique(source, "rooms", [r.id for r in f.rooms])
     object_ids = _unique(source, "objects", [o.id for o in f.objects])
+    for kind in ("doors", "windows", "lights"):
+        _unique(source, kind, [item.id for item in getattr(f, kind)])
+    _distinct_floors(source, f.rooms)
+    _on_the_plan(source, f)
     refs = _References(source, room_ids, object_ids)
     for i, w in enumerate(f.walls):
         refs.room(f"walls[{i}].room", w.room)
@@ -431,6 +446,47 @@ def house_from_dict(data: Any, source: str) -> House:
     if house.room_at(x, y) is None:
         raise FileFieldError(source, "station.position", "outside every room")
     return house
+
+
+def _distinct_floors(source: str, rooms: Sequence[_Room]) -> None:
+    """Two rooms on one floor outline are a copy-paste slip (room_at could answer either)."""
+    seen: dict[frozenset, str] = {}
+    for i, r in enumerate(rooms):
+        key = frozenset((round(x, 3), round(y, 3)) for x, y in map(_xy, r.floor))
+        if key in seen:
+            raise FileFieldError(source, f"rooms[{i}].floor", f"the same outline as room {seen[key]!r}")
+        seen[key] = r.id
+
+
+def _on_the_plan(source: str, f: HouseFile) -> None:
+    """Objects (every model box), doors, windows, lights and walls lie on the floor plan's bounding box
+    grown by PLAN_MARGIN: something hundreds of metres away, or a box covering the house, is a slip."""
+    points = [p for r in f.rooms for outline in (r.floor, *r.extra_floors) for p in outline]
+    lo = (min(p[0] for p in points) - PLAN_MARGIN, min(p[1] for p in points) - PLAN_MARGIN)
+    hi = (max(p[0] for p in points) + PLAN_MARGIN, max(p[1] for p in points) + PLAN_MARGIN)
+
+    def check(field_path: str, x: float, y: float, half_x: float = 0.0, half_y: float = 0.0) -> None:
+        if x - half_x < lo[0] or x + half_x > hi[0] or y - half_y < lo[1] or y + half_y > hi[1]:
+            raise FileFieldError(source, field_path, f"outside the house: beyond its floor plan "
+                                 f"({lo[0]:.1f}..{hi[0]:.1f}, {lo[1]:.1f}..{hi[1]:.1f} m with the margin)")
+    for i, o in enumerate(f.objects):
+        c, s = abs(math.cos(o.yaw)), abs(math.sin(o.yaw))
+        for j, m in enumerate(o.models):
+            (x, y), (sx, sy) = _xy(m.position), _xy(m.size)
+            check(f"objects[{i}].models[{j}]", x, y, (c * sx + s * sy) / 2, (s * sx + c * sy) / 2)
+    placed: dict[str, Sequence[_Door | _Window | _Light]] = {"doors": f.doors, "windows": f.windows,
+                                                              "lights": f.lights}
+    for kind, items in placed.items():
+        for i, item in enumerate(items):
+            check(f"{kind}[{i}].position", *_xy(item.position))
+    for i, w in enumerate(f.walls):
+        check(f"walls[{i}].a", *_xy(w.a))
+        check(f"walls[{i}].b", *_xy(w.b))
+
+
+def _xy(point: Any) -> tuple[float, float]:
+    """x, y of a validated point or size (the schema's tuple types are built at run time)."""
+    return float(point[0]), float(point[1])
 
 
 def _poly(points: list) -> Polygon:

@@ -19,20 +19,21 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Annotated, Any
 
-import yaml
 from pydantic import AfterValidator, Field
 
 from ravh_msgs_py.appearance import DOOR, SEED_MAX, SUN_PRESETS, SWITCH
 from ravh_msgs_py.names import DEFAULT_PROFILE
 from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
 from ravh_sim.paths import DEFAULT_CONFIG, ROBOTS_DIR
-from ravh_sim.schema import Strict, read_text, shown, validate
+from ravh_sim.schema import Strict, load_yaml, read_text, shown, validate
 from ravh_sim.world import paints
 from ravh_sim.world.house import House, Light
 from ravh_sim.world.solids import model_count
 
 DOOR_STATES = ("default", *DOOR)          # a settings file may also keep a door as the house has it
 AGENT_CLEARANCE = 0.5      # m between two agents' start positions (two Giraff radii)
+MAX_AGENTS = 32            # each is a simulated robot with its own sensors
+RESERVED_AGENT_NAMES = ("ravh",)   # a second agent's names are prefixed with its name: ravh/... is the sim's
 
 
 # --------------------------------------------------------------------------- the file's schema
@@ -125,7 +126,7 @@ class SettingsFile(Strict):
     doors: _Doors
     paint: _Paint
     models: _Models
-    agents: list[_Agent]
+    agents: Annotated[list[_Agent], Field(max_length=MAX_AGENTS)]
 
 
 def check_seed(seed: Any) -> int:
@@ -340,6 +341,9 @@ def _resolve_agents(cfg: list[dict], house: House, source: str) -> tuple[AgentSp
         name = a.get("name") or f"robot{i}"
         if name in names:
             raise FileFieldError(source, f"agents[{i}].name", f"duplicate agent name {name!r}")
+        if name in RESERVED_AGENT_NAMES:
+            raise FileFieldError(source, f"agents[{i}].name", f"{name!r} is reserved: the sim's own topics "
+                                 f"and services are named {name}/...")
         names.add(name)
         profile = a.get("profile", DEFAULT_PROFILE)
         if not (ROBOTS_DIR / f"{profile}.yaml").exists():
@@ -375,15 +379,7 @@ def _per_item(cfg: dict, key: str, known: dict, kind: str, source: str) -> dict:
 
 
 def _read_yaml(path: Path) -> dict[str, Any]:
-    text = read_text(path, "settings")
-    try:
-        data = yaml.safe_load(text)
-    except RecursionError:
-        raise FileFieldError(path, "(top level)", "nested too deeply") from None
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None)
-        where = f"line {mark.line + 1} column {mark.column + 1}" if mark else "-"
-        raise FileFieldError(path, where, f"invalid YAML: {getattr(e, 'problem', e)}") from None
+    data = load_yaml(read_text(path, "settings"), path)
     if data is None:
         return {}
     if not isinstance(data, dict):
