@@ -83,7 +83,9 @@ class Probe:
 
 @pytest.fixture(scope="module")
 def sim():
-    proc = NodeProcess("sim", "--house", HOUSE, "--seed", "0")
+    # every frame, so image rates in sim time are the camera's on a loaded machine too (the default,
+    # dropping frames to keep real time, is tested in test_streaming.py)
+    proc = NodeProcess("sim", "--house", HOUSE, "--seed", "0", "--frame-policy", "wait")
     probe = Probe()
     ok = spin_until(probe.node, lambda: len(probe.got[n.COLOR_IMAGE]) >= 3 and probe.got[n.GROUND_TRUTH], 90)
     assert ok, f"sim did not publish images:\n{proc.log()[-3000:]}"
