@@ -202,6 +202,32 @@ SCAN_TARGET_MS = 2.0
 SENSOR_REPEATS = 3
 
 
+ROUTE_STEP_M = 1.0                  # a frame every metre along the route
+
+
+def route_poses(world: Any, profile: Any, step: float = ROUTE_STEP_M) -> list[tuple[float, float, float]]:
+    """Poses along the route ``ravh bench node`` drives (the wanderer, ``--order cyclic``: from the
+    station to every room in house order), one every ``step`` metres, heading along the path."""
+    from ravh_sim.nav.navigation import Navigation
+    from ravh_sim.nav.planner import Unreachable
+
+    house = world.house
+    navigation = Navigation(house, world.state, profile)
+    at = house.station.position[:2]
+    poses = [(at[0], at[1], house.station.yaw)]
+    for room in house.rooms:
+        try:
+            points = navigation.plan(at, navigation.room_goal(room.id, at)).points
+        except Unreachable:
+            continue
+        for (x0, y0), (x1, y1) in zip(points, points[1:]):
+            length, yaw = math.dist((x0, y0), (x1, y1)), math.atan2(y1 - y0, x1 - x0)
+            poses += [(x0 + (x1 - x0) * d / length, y0 + (y1 - y0) * d / length, yaw)
+                      for d in [i * step for i in range(int(length / step))] if length > 0]
+        at = points[-1]
+    return poses
+
+
 def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
     """Sensor speed: one camera capture (RGB + depth + instance, 640x480) with the realistic GL
     renderer, the fast GL renderer and pybullet's TinyRenderer (the baseline), on the same poses in
@@ -209,7 +235,8 @@ def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
     360-ray laser scan.
 
     Poses: the station and every room centre that lies inside its room, headings turning by 90
-    degrees, default settings (day, ceiling lights on). Medians over all poses and repeats.
+    degrees, default settings (day, ceiling lights on); and, as ``route_*``, frames every metre along
+    the route ``ravh bench node`` drives. Medians over all poses and repeats.
     """
     from dataclasses import replace
 
@@ -228,6 +255,7 @@ def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
     configs = {"realistic": ("gl", "realistic"), "fast": ("gl", "fast"), "tiny": ("tiny", "fast"),
                "realistic_night_all_lights": ("gl", "realistic")}
     camera_ms: dict[str, list[float]] = {name: [] for name in configs}
+    route_ms: dict[str, list[float]] = {name: [] for name in configs}
     scan_ms: list[float] = []
     for n in houses or SENSOR_HOUSES:
         house = load_house(n)
@@ -251,6 +279,9 @@ def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
                      for _ in range(SENSOR_REPEATS) for pose in poses]
             camera_ms[name] += times
             detail[f"house{n}_camera_ms_{name}"] = round(statistics.median(times), 2)
+            route = route_poses(world, profile)
+            route_ms[name] += [_timed(camera.capture, *pose)[0] * 1000 for pose in route]
+            detail[f"house{n}_route_frames"] = len(route)
             if name == "tiny":
                 laser = Laser(world, profile.laser)
                 scan_ms += [_timed(laser.scan, *pose)[0] * 1000
@@ -258,9 +289,12 @@ def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
             camera.close()
             world.close()
     medians = {name: round(statistics.median(ms), 2) if ms else None for name, ms in camera_ms.items()}
+    on_route = {name: round(statistics.median(ms), 2) if ms else None for name, ms in route_ms.items()}
     tiny = medians["tiny"]
     return {
         **{f"camera_ms_{name}": ms for name, ms in medians.items()},
+        **{f"route_camera_ms_{name}": ms for name, ms in on_route.items()},
+        "route_speedup_realistic_vs_tiny": _ratio(on_route["tiny"], on_route["realistic"]),
         "speedup_realistic_vs_tiny": _ratio(tiny, medians["realistic"]),
         "speedup_fast_vs_tiny": _ratio(tiny, medians["fast"]),
         "scan_ms": round(statistics.median(scan_ms), 3) if scan_ms else None,

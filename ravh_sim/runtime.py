@@ -10,7 +10,7 @@ node only converts and publishes.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -121,6 +121,18 @@ class SimRuntime:
     def read(self, agent: Agent, port: str) -> Any:
         """The data of ``agent``'s sensor of port ``port`` now (a Capture, a Scan, ...)."""
         return PORTS[port].read(agent.sensors[port], agent.robot)
+
+    def skip(self, agent: Agent, port: str) -> None:
+        """A reading due but not taken (nobody listens, or the camera is busy): it still uses up its
+        number, so the noise of later readings, captures among them, does not depend on who listened."""
+        agent.sensors[port].count += 1
+
+    def frame_later(self, agent: Agent) -> Callable[[], Capture]:
+        """``agent``'s camera frame as of now (pose, velocity and frame number fixed now), rendered when
+        called: the sim node renders on its own thread while physics goes on."""
+        camera, robot = agent.sensors["camera"], agent.robot
+        (x, y, yaw), velocity, index = robot.pose, robot.velocity, camera.take_index()
+        return lambda: camera.capture(x, y, yaw, velocity=velocity, index=index)
 
     def capture(self, agent: Agent) -> Capture:
         return self.read(agent, "camera")

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -31,6 +32,36 @@ def test_sensors_fall_due_at_their_rates(runtime):
             counts[what] += runtime.due(agent, what)
     assert counts == {"camera": pytest.approx(20, abs=1), "scan": pytest.approx(20, abs=1),
                       "odom": pytest.approx(100, abs=1)}
+
+
+def test_a_frame_not_taken_still_uses_up_its_number(runtime):
+    """Lazy sensors skip frames nobody listens to; with camera noise on, a later capture must be the
+    bytes it would have been had every frame been rendered."""
+    agent = runtime.agents[0]
+    camera = agent.sensors["camera"]
+    options, start = camera.options, camera.count
+    camera.options = replace(options, pixel_noise=8.0)
+    try:
+        eager = [runtime.capture(agent) for _ in range(3)]
+        camera.count = start
+        runtime.skip(agent, "camera")
+        runtime.skip(agent, "camera")
+        lazy = runtime.frame_later(agent)()
+        assert lazy.index == eager[2].index == start + 2
+        assert np.array_equal(lazy.rgb, eager[2].rgb) and not np.array_equal(eager[1].rgb, eager[2].rgb)
+    finally:
+        camera.options = options
+
+
+def test_a_frame_asked_for_shows_the_pose_it_was_asked_at(runtime):
+    agent = runtime.agents[0]
+    before = agent.robot.pose
+    frame = runtime.frame_later(agent)
+    agent.robot.teleport(before[0], before[1], before[2] + 1.0)
+    try:
+        assert frame().robot_pose == before
+    finally:
+        runtime.reset()
 
 
 def test_commands_are_validated(runtime):

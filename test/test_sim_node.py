@@ -84,7 +84,9 @@ class Probe:
 
 @pytest.fixture(scope="module")
 def sim():
-    with NodeProcess("sim", "--house", HOUSE, "--seed", "0") as proc:
+    # every frame, so image rates in sim time are the camera's on a loaded machine too (the default,
+    # dropping frames to keep real time, is tested in test_streaming.py)
+    with NodeProcess("sim", "--house", HOUSE, "--seed", "0", "--frame-policy", "wait") as proc:
         probe = Probe()
         try:
             ok = spin_until(probe.node, lambda: len(probe.got[n.COLOR_IMAGE]) >= 3 and probe.got[n.GROUND_TRUTH], 90)

@@ -12,8 +12,19 @@ With ``--lockstep`` it advances only as far as a behaviour grants on ``ravh/step
 command for that step), so a run depends on sim time alone and repeats exactly with the same seed.
 Sensor topics come from the sensor suite (ravh_sim.sensors.suite): each port's topics, published at
 its rate (the robot profile's; ``camera_rate``, ``scan_rate``, ``odom_rate`` override them for every
-agent when >= 0). Requests never take it down: bad commands are refused with a throttled warning,
-bad service requests get an error reply.
+agent when >= 0). A sensor topic nobody subscribes to costs nothing: a reading is taken only for the
+topics that have subscribers (no render, no JPEG for nobody); requested captures always are.
+
+Camera frames are rendered and converted on one render thread (it owns the GL context, the cameras'
+renderers and every change to the world's appearance), so physics, /clock, odometry, /tf and scans
+keep their rates while a frame renders (in sim time: moderngl holds the GIL while it waits for llvmpipe,
+so on a CPU the loop pauses then and catches up after); a frame is stamped with the sim time of its pose.
+``frame_policy`` says what happens when a frame falls due while the last one still renders: ``drop``
+(default) skips it, keeping the real-time factor, as a real camera drops frames and as Nav2 and
+slam_toolbox expect of a clock that follows the wall clock (logged once); ``wait`` keeps every frame
+by holding sim time until the last frame is out (the camera's rate in sim time, a slower sim).
+Requests never take it down: bad commands are refused with a throttled warning, bad service
+requests get an error reply.
 """
 from __future__ import annotations
 
@@ -23,6 +34,7 @@ import math
 import time
 from collections import deque
 from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
 from typing import Any
 
 from diagnostic_msgs.srv import AddDiagnostics
@@ -55,7 +67,7 @@ from ravh_sim.nodes.common import (
 )
 from ravh_sim.render.backend import BACKENDS
 from ravh_sim.runtime import ODOM, Agent, SimRuntime
-from ravh_sim.sensors.ports import SensorPort
+from ravh_sim.sensors.ports import SensorPort, Topic
 from ravh_sim.sensors.suite import SENSORS
 
 TICK_S = 0.005                          # wall period of the stepping timer
@@ -63,6 +75,8 @@ MAX_STEP_S = 0.1                        # sim time advanced per tick at most (ke
 CMD_TIMEOUT_S = 0.5                     # stop a robot whose commands stop arriving (sim seconds)
 WARN_THROTTLE_S = 2.0
 MAP_TF_MODES = ("auto", "on", "off")
+FRAME_POLICIES = ("drop", "wait")       # a frame due while the last renders: skip it | hold sim time
+CAMERA = "camera"                       # the port rendered on the render thread (the others are cheap)
 MAP_TF_RESUME_S = 2.0                   # wall s without another map -> odom publisher before the sim takes over
 # Listening for other map -> odom publishers: best effort matches reliable and best-effort publishers.
 TF_LISTEN_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT)
@@ -73,7 +87,7 @@ RATE_PARAMETERS = {f"{key}_rate": key for key in (*(port.name for port in SENSOR
 PARAMETERS: dict[str, Any] = {
     "house": 15, "seed": -1, "config": "", "footprint": "", "renderer": "auto", "real_time_factor": 1.0,
     **dict.fromkeys(RATE_PARAMETERS, FROM_PROFILE), "clock_rate": 100.0,
-    "cmd_vel_stamped": False, "map_tf": "auto", "lockstep": False,
+    "cmd_vel_stamped": False, "map_tf": "auto", "lockstep": False, "frame_policy": "drop",
 }
 HEARTBEAT_S = 0.5                       # lockstep: wall period of /clock and pose while waiting
 
@@ -94,9 +108,18 @@ class SimNode(Node):
         for param, key in RATE_PARAMETERS.items():
             if key in rates and not (math.isfinite(rates[key]) and rates[key] >= 0):
                 raise UserError(f"{param} must be >= 0 Hz (0 = never), got {rates[key]}")
+        self.frame_policy = str(p["frame_policy"])
+        if self.frame_policy not in FRAME_POLICIES:
+            raise UserError(f"frame_policy must be one of {', '.join(FRAME_POLICIES)}, got {self.frame_policy!r}")
         self.clock_period = 1.0 / max(float(p["clock_rate"]), 1e-3)
-        self.runtime = SimRuntime(int(p["house"]), p["config"] or None, None if p["seed"] == -1 else p["seed"],
-                                  renderer=p["renderer"], rates=rates, footprint=p["footprint"] or None)
+        # The one thread that touches the renderers: the process's GL context is made, and stays current,
+        # on the thread that builds the runtime (ravh_sim.render.backend), so the runtime is built there.
+        self.render_thread = ThreadPoolExecutor(max_workers=1, thread_name_prefix="ravh_render")
+        self.runtime = self._on_render_thread(
+            SimRuntime, int(p["house"]), p["config"] or None, None if p["seed"] == -1 else p["seed"],
+            renderer=p["renderer"], rates=rates, footprint=p["footprint"] or None)
+        self._frames: dict[str, Future] = {}          # agent -> its camera frame being rendered
+        self._dropping = False
         rt = self.runtime
         self.get_logger().info(
             f"house {rt.house.number}: {len(rt.house.rooms)} rooms, {len(rt.house.objects)} objects, "
@@ -119,6 +142,10 @@ class SimNode(Node):
             self.create_subscription(TFMessage, n.TF, self._on_tf, TF_LISTEN_QOS)
         self._publish_latched()
         self.timer = self.create_timer(TICK_S, self._tick)
+
+    def _on_render_thread(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+        """``fn(*args, **kwargs)`` run on the render thread (after the frames queued before it); its result."""
+        return self.render_thread.submit(fn, *args, **kwargs).result()
 
     # ------------------------------------------------------------------ set-up
     def _make_publishers(self) -> None:
@@ -227,7 +254,7 @@ class SimNode(Node):
                 self._publish_state(agent)
             for port in SENSORS:
                 if rt.due(agent, port.name):
-                    self._publish_sensor(agent, port)
+                    self._stream(agent, port)
 
     # ------------------------------------------------------------------ publishing
     def _now(self) -> float:
@@ -304,20 +331,57 @@ class SimNode(Node):
             pubs["last_room"] = room
             pubs["room"].publish(String(data=room or ""))
 
-    def _publish_sensor(self, agent: Agent, port: SensorPort) -> None:
-        """One reading of ``agent``'s sensor of ``port``: every topic of it with one stamp."""
-        data, pubs = self.runtime.read(agent, port.name), self.agent_pubs[agent.name]
-        frame = self._frame(agent, port.frame)
-        hdr = convert.header(self._now(), frame)
-        for topic in port.topics:
+    def _stream(self, agent: Agent, port: SensorPort) -> None:
+        """A reading of ``port`` that fell due: published on the topics that have subscribers (none:
+        not taken); a camera frame goes to the render thread, as ``frame_policy`` says when it is busy."""
+        pubs, rt = self.agent_pubs[agent.name], self.runtime
+        topics = tuple(t for t in port.topics if pubs[t.key].get_subscription_count() > 0)
+        if not topics:
+            rt.skip(agent, port.name)
+            return
+        if port.name != CAMERA:
+            self._publish_sensor(agent, port, rt.read(agent, port.name), self._now(), topics)
+            return
+        busy = self._frames.get(agent.name)
+        if busy is not None and not busy.done() and self.frame_policy == "drop":
+            rt.skip(agent, port.name)
+            if not self._dropping:
+                self._dropping = True
+                self.get_logger().warning(
+                    f"the camera cannot keep {agent.rates[port.name]:g} Hz at real-time factor {self.rtf:g}: "
+                    "frames that fall due while one renders are dropped (frame_policy:=wait keeps every "
+                    "frame by slowing the sim)")
+            return
+        if busy is not None:
+            busy.result()                 # wait: sim time holds until the frame is out; raises its error
+        self._frames[agent.name] = self.render_thread.submit(
+            self._render_frame, agent, port, rt.frame_later(agent), self._now(), topics)
+
+    def _render_frame(self, agent: Agent, port: SensorPort, frame: Callable[[], Any], stamp: float,
+                      topics: tuple[Topic, ...]) -> None:
+        """On the render thread: render ``frame`` and publish it on ``topics``, stamped ``stamp`` (when it
+        was asked for: the sim time of its pose)."""
+        self._publish_sensor(agent, port, frame(), stamp, topics)
+
+    def _publish_sensor(self, agent: Agent, port: SensorPort, data: Any, stamp: float,
+                        topics: tuple[Topic, ...]) -> None:
+        """One reading ``data`` of ``agent``'s sensor of ``port`` on ``topics``, all with one stamp."""
+        pubs, frame = self.agent_pubs[agent.name], self._frame(agent, port.frame)
+        hdr = convert.header(stamp, frame)
+        for topic in topics:
             value = topic.value(data, agent.sensors[port.name], frame)
             pubs[topic.key].publish(convert.KINDS[topic.kind].to_message(value, hdr))
 
     def _publish_capture(self, agent: Agent) -> CaptureEvent:
-        """A requested capture: every sensor of the agent at one stamp, then the event on ravh/capture
-        (pose, room) so recorders can store it as one dataset sample."""
+        """A requested capture: every sensor of the agent at one stamp on every topic, subscribed or
+        not (rendered on the render thread, after the frames already queued), then the event on
+        ravh/capture (pose, room) so recorders can store it as one dataset sample."""
+        rt, stamp = self.runtime, self._now()
         for port in SENSORS:
-            self._publish_sensor(agent, port)
+            if port.name == CAMERA:
+                self._on_render_thread(self._render_frame, agent, port, rt.frame_later(agent), stamp, port.topics)
+            else:
+                self._publish_sensor(agent, port, rt.read(agent, port.name), stamp, port.topics)
         event = self.runtime.capture_event(agent)
         self.agent_pubs[agent.name]["capture"].publish(String(data=event.to_json()))
         return event
@@ -367,7 +431,8 @@ class SimNode(Node):
         return response
 
     def _on_appearance(self, request: AddDiagnostics.Request, response: AddDiagnostics.Response):
-        reply = self.runtime.change_appearance(request.load_namespace)
+        # on the render thread: a renderer reads the world's appearance while it renders
+        reply = self._on_render_thread(self.runtime.change_appearance, request.load_namespace)
         response.success, response.message = bool(reply["ok"]), json.dumps(reply)
         _forget_if_oversized(request)
         if reply["ok"]:
@@ -401,7 +466,7 @@ class SimNode(Node):
 
     def _on_reset(self, request: Trigger.Request, response: Trigger.Response):
         try:
-            self.runtime.reset()
+            self._on_render_thread(self.runtime.reset)
             self._publish_footprint()
             response.success, response.message = True, "agents back at their start poses"
         except Exception as e:  # never die from a request
@@ -417,7 +482,8 @@ class SimNode(Node):
         return response
 
     def close(self) -> None:
-        self.runtime.close()
+        self._on_render_thread(self.runtime.close)
+        self.render_thread.shutdown()
 
 
 def _forget_if_oversized(request: AddDiagnostics.Request) -> None:
@@ -452,6 +518,9 @@ def parse_args(argv: list[str]) -> dict[str, Any]:
                         "does), on (always the sim), off (never the sim)")
     p.add_argument("--lockstep", action="store_true", default=None,
                    help="advance sim time only as far as a behaviour grants on ravh/step (reproducible runs)")
+    p.add_argument("--frame-policy", dest="frame_policy", choices=FRAME_POLICIES,
+                   help="a camera frame due while the last one renders: drop (default: keep the real-time "
+                        "factor, publish fewer frames) or wait (keep the camera rate, slow the sim)")
     args = p.parse_args(argv)
     return {k: v for k, v in vars(args).items() if v is not None}
 

@@ -145,13 +145,21 @@ class SmartCamera:
         views = self.renderer.render(position, rotation, self.options.manual_exposure)
         return Frame(views.rgb, views.depth, views.instance, views.background, position, rotation)
 
+    def take_index(self) -> int:
+        """The next capture number, used up: a frame due but not rendered (nobody listening) takes
+        its number too, so the noise of later frames does not depend on who listened."""
+        self.count += 1
+        return self.count - 1
+
     def capture(self, x: float, y: float, yaw: float, floor_z: float | None = None,
-                velocity: tuple[float, float] = (0.0, 0.0)) -> Capture:
-        """Render the view from robot pose (x, y, yaw); ``velocity`` (v m/s, w rad/s) for motion blur."""
+                velocity: tuple[float, float] = (0.0, 0.0), index: int | None = None) -> Capture:
+        """Render the view from robot pose (x, y, yaw); ``velocity`` (v m/s, w rad/s) for motion blur;
+        ``index``: a number taken earlier with :meth:`take_index` (None: the next one)."""
         opts = self.options
+        index = self.take_index() if index is None else index
         frame = self.render(x, y, yaw, floor_z)
         rgb, depth, instance = frame.rgb, frame.depth, frame.instance
-        rng = noise_rng(self.world.state.seed, NOISE_STREAM, self.agent, self.count)
+        rng = noise_rng(self.world.state.seed, NOISE_STREAM, self.agent, index)
         if opts.motion_blur and any(velocity):
             distance = float(np.nanmedian(depth)) if np.isfinite(depth).any() else self.spec.far
             rgb = imaging.motion_blur(rgb, self.K, velocity[0], velocity[1], opts.exposure, distance)
@@ -165,10 +173,8 @@ class SmartCamera:
             depth = imaging.depth_noise(depth, opts.depth_noise, rng)
         if opts.jpeg_roundtrip:
             rgb = imaging.jpeg_roundtrip(rgb, opts.jpeg_quality)
-        capture = Capture(rgb, depth, instance, self.K.copy(), self.camera_info, (x, y, yaw), frame.position,
-                          quaternion_from_matrix(frame.rotation), self.count)
-        self.count += 1
-        return capture
+        return Capture(rgb, depth, instance, self.K.copy(), self.camera_info, (x, y, yaw), frame.position,
+                       quaternion_from_matrix(frame.rotation), index)
 
     def instance_color(self, capture: Capture) -> np.ndarray:
         """(H, W, 3) uint8 image of the instance ids in their footprint mask colours (black = nothing)."""

@@ -1,0 +1,167 @@
+"""The sim node's sensor streams in this process: lazy sensors and frames rendered off the control loop.
+
+The camera's renderer is replaced by a stand-in that counts its renders and is as slow as a test says
+(in sim time, so nothing here is timed), the node runs on the real runtime and publishes over DDS.
+"""
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+from rosgraph import start_rclpy
+
+rclpy = pytest.importorskip("rclpy")
+
+from rclpy.executors import SingleThreadedExecutor  # noqa: E402
+from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
+from rosgraph_msgs.msg import Clock  # noqa: E402
+from sensor_msgs.msg import Image, LaserScan  # noqa: E402
+from std_srvs.srv import Trigger  # noqa: E402
+
+from ravh_msgs_py import names as n  # noqa: E402
+from ravh_sim.nodes import convert  # noqa: E402
+from ravh_sim.render.views import RenderedViews  # noqa: E402
+from ravh_sim.sensors import imaging  # noqa: E402
+
+# deep enough that the test, spinning the node in its own thread, loses nothing
+KEEP_ALL = QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE)
+PERIOD = 0.1                       # the camera's and the laser's period (giraff profile, 10 Hz)
+
+
+class StandInRenderer:
+    """Flat views after ``slow()`` says the render may end; records the sim time each render began."""
+
+    def __init__(self, node, width: int, height: int) -> None:
+        self.node, self.shape = node, (height, width)
+        self.began: list[float] = []
+        self.slow: Callable[[float], bool] = lambda began: True
+
+    def render(self, position, rotation, exposure=None) -> RenderedViews:
+        began = self.node.runtime.time
+        self.began.append(began)
+        give_up = time.monotonic() + 60.0
+        while not self.slow(began) and time.monotonic() < give_up:
+            time.sleep(0.002)
+        h, w = self.shape
+        return RenderedViews(np.full((h, w, 3), 128, np.uint8), np.full((h, w), 2.0, np.float32),
+                             np.ones((h, w), np.uint16), np.zeros((h, w), bool))
+
+    def release(self) -> None:
+        pass
+
+
+class Session:
+    """A sim node (house 20, real time) with a stand-in renderer, and a test node beside it."""
+
+    def __init__(self, policy: str) -> None:
+        from ravh_sim.nodes.sim_node import SimNode
+        start_rclpy()
+        self.sim = SimNode({"house": 20, "seed": 0, "renderer": "tiny", "frame_policy": policy})
+        self.agent = self.sim.runtime.agents[0]
+        camera = self.agent.sensors["camera"]
+        camera.renderer = self.renderer = StandInRenderer(self.sim, camera.width, camera.height)
+        laser = self.agent.sensors["scan"]
+        self.scans_cast = 0
+        cast = laser.scan
+
+        def counted(*args, **kwargs):
+            self.scans_cast += 1
+            return cast(*args, **kwargs)
+        laser.scan = counted
+        self.node = rclpy.create_node(f"streams_{time.monotonic_ns()}")
+        self.executor = SingleThreadedExecutor()
+        for node in (self.sim, self.node):
+            self.executor.add_node(node)
+        self.got: dict[str, list] = {}
+
+    def listen(self, kind, topic: str) -> list:
+        self.got[topic] = []
+        self.node.create_subscription(kind, topic, self.got[topic].append, KEEP_ALL)
+        return self.got[topic]
+
+    def spin_until(self, condition: Callable[[], bool], timeout: float = 120.0) -> None:
+        end = time.monotonic() + timeout
+        while not condition():
+            assert time.monotonic() < end, "timed out"
+            self.executor.spin_once(timeout_sec=0.01)
+
+    def capture(self) -> Trigger.Response:
+        client = self.node.create_client(Trigger, n.CAPTURE_SERVICE)
+        assert client.wait_for_service(timeout_sec=30)
+        future = client.call_async(Trigger.Request())
+        self.spin_until(future.done)
+        return future.result()
+
+    def close(self) -> None:
+        self.executor.shutdown()
+        self.sim.close()
+        self.sim.destroy_node()
+        self.node.destroy_node()
+
+
+def stamps(msgs: list) -> np.ndarray:
+    return np.array([convert.seconds(m.clock if isinstance(m, Clock) else m.header.stamp) for m in msgs])
+
+
+@pytest.fixture(scope="class")
+def session():
+    s = Session("drop")
+    yield s
+    s.close()
+
+
+class TestDroppingFrames:
+    def test_nobody_subscribed_renders_and_scans_nothing_but_captures(self, session, monkeypatch):
+        jpegs = []
+        encode = imaging.encode_jpeg
+        monkeypatch.setattr(imaging, "encode_jpeg", lambda *a: jpegs.append(1) or encode(*a))
+        session.spin_until(lambda: session.sim.runtime.time >= 2.0)
+        camera = session.agent.sensors["camera"]
+        assert session.renderer.began == [] and session.scans_cast == 0 and jpegs == []
+        assert camera.count >= 2.0 / PERIOD        # every due frame used up its number
+        reply = session.capture()
+        assert reply.success
+        assert len(session.renderer.began) == 1 and session.scans_cast == 1 and len(jpegs) == 1
+
+    def test_a_subscriber_that_joins_gets_frames_of_its_kind_only(self, session, monkeypatch):
+        jpegs = []
+        encode = imaging.encode_jpeg
+        monkeypatch.setattr(imaging, "encode_jpeg", lambda *a: jpegs.append(1) or encode(*a))
+        rendered = len(session.renderer.began)
+        images = session.listen(Image, n.COLOR_IMAGE)
+        session.spin_until(lambda: len(images) >= 3)
+        assert len(session.renderer.began) >= rendered + 3
+        assert jpegs == [] and session.scans_cast == 1      # no subscriber on compressed images, on scans
+        assert images[-1].header.frame_id == n.CAMERA_OPTICAL_FRAME
+
+    def test_clock_and_scans_keep_their_rate_while_a_frame_renders(self, session):
+        # a renderer so slow that the sim runs a whole second while it renders one frame
+        session.renderer.slow = lambda began: session.sim.runtime.time >= began + 1.0
+        clock, scans = session.listen(Clock, n.CLOCK), session.listen(LaserScan, n.SCAN)
+        images = session.listen(Image, n.COLOR_IMAGE)
+        session.spin_until(lambda: len(images) >= 3)
+        frames = stamps(images)
+        assert np.all(np.diff(frames) >= 1.0 - 1e-6)        # frames that fell due while one rendered: dropped
+        window = (frames[0], frames[-1])
+        scan_t, clock_t = stamps(scans), stamps(clock)
+        scan_t = scan_t[(scan_t >= window[0]) & (scan_t <= window[1])]
+        clock_t = clock_t[(clock_t >= window[0]) & (clock_t <= window[1])]
+        assert len(scan_t) >= (window[1] - window[0]) / PERIOD - 1
+        assert np.allclose(np.diff(scan_t), PERIOD, atol=1e-3)          # every scan, none late
+        assert np.diff(clock_t).max() < 2 * session.sim.clock_period       # on physics steps: no gap
+
+
+class TestWaitingForFrames:
+    def test_every_frame_is_kept_by_slowing_the_sim(self):
+        s = Session("wait")
+        try:
+            # each render lasts while the sim could run three camera periods at real time
+            ends: dict[float, float] = {}
+            s.renderer.slow = lambda began: time.monotonic() >= ends.setdefault(began, time.monotonic() + 3 * PERIOD)
+            images = s.listen(Image, n.COLOR_IMAGE)
+            s.spin_until(lambda: len(images) >= 6)
+            assert np.allclose(np.diff(stamps(images)[1:]), PERIOD, atol=1e-3)    # the first: the first step
+        finally:
+            s.close()
