@@ -32,7 +32,7 @@ setup(
     ],
     package_data={"ravh_sim.render": ["shaders/*.glsl", "shaders/*.vert", "shaders/*.frag"]},
     install_requires=["numpy", "pybullet", "opencv-python-headless", "pyyaml", "pydantic>=2", "trimesh", "rosbags",
-                      "moderngl", "tqdm"],
+                      "moderngl", "tqdm", "pycocotools"],
     extras_require={"ray": ["ray"]},          # ravh dataset build --ray: raids as tasks on a Ray cluster
     zip_safe=True,
     maintainer="ravh_sim developers",

@@ -333,7 +333,23 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--max-nodes", type=int, default=0, help="grid raids: visit only N nodes (0: all)")
     p.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     p.set_defaults(func=cmd_build)
+    e = commands.add_parser("export", help="datasets under DIR in a detector-training format (COCO)")
+    e.add_argument("dir", type=Path, metavar="DIR", help="a dataset folder, or a build's OUT with many")
+    e.add_argument("--format", choices=("coco",), required=True,
+                   help="coco: instances.json (boxes, RLE masks, categories) + semantic/ class images")
+    e.add_argument("--out", type=Path, default=None, help="where instances.json goes (default DIR/coco)")
+    e.add_argument("--min-pixels", type=int, default=1, help="annotate objects covering at least N pixels")
+    e.set_defaults(func=cmd_export)
     dataset.set_defaults(func=lambda args: dataset.print_help() or 2)
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    from ravh_sim.dataset.coco import INSTANCES_JSON, export_coco
+    out = args.out or args.dir / "coco"
+    counts = export_coco(args.dir, out, args.min_pixels)
+    print(f"{counts['images']} images, {counts['annotations']} annotations from {counts['datasets']} datasets: "
+          f"{out / INSTANCES_JSON} (semantic class images in each dataset's semantic/)")
+    return 0
 
 
 def cmd_build(args: argparse.Namespace) -> int:
