@@ -289,8 +289,8 @@ def summary_table(result: dict[str, Any], paper: dict[int, dict[int, int]] | Non
     for house in sorted({h for h, _ in ours}):
         row = f"{house:<6}"
         for raid in raids:
-            n, p = ours.get((house, raid)), paper.get(house, {}).get(raid)
-            text = "-" if n is None else f"{n}" if not p else f"{n}/{p} {n / p:.2f}"
+            n, theirs = ours.get((house, raid)), paper.get(house, {}).get(raid)
+            text = "-" if n is None else f"{n}" if not theirs else f"{n}/{theirs} {n / theirs:.2f}"
             row += f"{text:>{cell}}"
         lines.append(row)
     lines.append("")
