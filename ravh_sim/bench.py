@@ -329,8 +329,9 @@ def bench_raid(houses: list[int] | None = None) -> dict[str, Any]:
     import resource
     from pathlib import Path
 
-    from ravh_sim.dataset.build import PAPER_CAPTURES, BuildOptions, Job, raid_seed, run_job
+    from ravh_sim.dataset.build import BuildOptions, Job, raid_seed, run_job
     from ravh_sim.dataset.raid import PRESETS, run_raid
+    from ravh_sim.paper import table2
     from ravh_sim.world.house import available_houses, load_house
 
     def floor_area(n: int) -> float:
@@ -375,7 +376,7 @@ def bench_raid(houses: list[int] | None = None) -> dict[str, Any]:
                                            / sum(s["cpu_s"] for s in sampled), 2),
         "floor_m2_sample": round(sample_area, 1), "floor_m2_all_houses": round(total_area, 1),
         "dataset_captures_estimate": round(sum(s["captures"] for s in sampled) * total_area / sample_area),
-        "paper_captures": PAPER_CAPTURES,
+        "paper_captures": sum(sum(raids.values()) for raids in table2().values()),
         "dataset_cpu_hours": round(cpu_hours, 2), "cores": cores,
         "dataset_hours_this_machine": round(cpu_hours / cores, 2),
         "dataset_hours_8_cores": round(cpu_hours / 8, 2), "dataset_hours_64_cores": round(cpu_hours / 64, 2),

@@ -19,3 +19,4 @@ CONFIG_DIR = DATA_DIR / "config"
 ROBOTS_DIR = CONFIG_DIR / "robots"
 DEFAULT_CONFIG = CONFIG_DIR / "default.yaml"
 FASTDDS_PROFILE = CONFIG_DIR / "fastdds_large_shm.xml"
+PAPER_DIR = CONFIG_DIR / "paper"                 # the paper's Tables 1-4 as TSV (README there)

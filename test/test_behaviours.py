@@ -10,7 +10,16 @@ from conftest import resolved
 from ravh_sim.behaviours.grid import GridSweep
 from ravh_sim.behaviours.teleop import Teleop
 from ravh_sim.behaviours.wanderer import Wanderer
-from ravh_sim.behaviours.waypoints import Layout, grid_nodes, light_waypoints
+from ravh_sim.behaviours.waypoints import (
+    PAPER_AGENT_RADIUS,
+    PAPER_NEAR,
+    Layout,
+    grid_nodes,
+    light_waypoints,
+    nearest_reachable_cells,
+    paper_grid_nodes,
+    paper_lattice,
+)
 from ravh_sim.nav.follower import PathFollower
 from ravh_sim.nav.grid import FREE, reachable
 from ravh_sim.nav.navigation import Navigation
@@ -92,6 +101,38 @@ def test_grid_nodes_cover_the_free_area_at_the_spacing(houses):
     assert nearest.max() <= 0.5 + 1e-6                              # every free cell near a node
     steps = np.linalg.norm(np.diff(pts, axis=0), axis=1)
     assert np.median(steps) <= 0.75                                # consecutive nodes are neighbours
+
+
+def test_paper_node_rule_keeps_lattice_points_a_thin_agent_reaches_and_stops_the_robot_nearby(houses):
+    house = houses[29]                        # the smallest house: 4 rooms, the paper's 320 grid captures
+    nav = Navigation(house, WorldState(resolved(house)), _profile())
+    walkable, grid = nav.walkable(PAPER_AGENT_RADIUS), nav.map()
+    start = house.station.position[:2]
+    kept = paper_lattice(walkable, start)
+    assert all(abs(v / 0.5 - round(v / 0.5)) < 1e-9 for p in kept for v in p)     # the house frame's 0.5 m lattice
+    reach = reachable(walkable, start)
+    on_mesh = [p for p in kept if reach[walkable.cell_of(*p)]]
+    off_mesh = [p for p in kept if not reach[walkable.cell_of(*p)]]
+    assert on_mesh and off_mesh                                      # points near but off the mesh are kept too
+    every = [(x * 0.5, y * 0.5) for x in range(-40, 41) for y in range(-40, 41)]
+    inside = [p for p in every if walkable.inside(*walkable.cell_of(*p)) and reach[walkable.cell_of(*p)]]
+    assert inside and set(inside) <= set(kept)                                # every lattice point on the mesh is kept
+    free_cells = np.argwhere(reach)
+    for p in off_mesh:
+        gap = np.min(np.linalg.norm(np.array([walkable.center_of(r, c) for r, c in free_cells]) - p, axis=1))
+        assert gap <= PAPER_NEAR + walkable.resolution
+    wider = paper_lattice(walkable, start, near=0.3)
+    assert len(wider) > len(kept)                                    # the allowance decides, not chance
+    nodes = paper_grid_nodes(Layout.of(house), walkable, grid, start)
+    assert len(nodes) == len(kept)
+    robot_reach = reachable(grid, start)
+    assert all(robot_reach[grid.cell_of(*n)] for n in nodes)         # the robot stops where it can go
+    stops = nearest_reachable_cells(grid, start, kept)
+    for p, (r, c) in zip(kept, stops):
+        own = grid.cell_of(*p)
+        if grid.inside(*own) and robot_reach[own]:
+            assert (r, c) == own                                     # a point the robot reaches is its own stop
+    assert 0.9 <= len(nodes) * 10 / 320 <= 1.3                       # Table 2: 320 grid captures in house 29
 
 
 def test_grid_sweep_takes_n_captures_per_node_all_around(rig):

@@ -16,7 +16,7 @@ import pytest
 from conftest import ROOT, subprocess_env
 
 from ravh_sim.dataset.api import Dataset
-from ravh_sim.dataset.build import build, parse_numbers, raid_seed
+from ravh_sim.dataset.build import build, parse_numbers, raid_seed, summary_table
 from ravh_sim.errors import UserError
 
 SMALL = ("--max-nodes", "1", "--max-captures", "12")        # grid: one node; wanderer: 12 captures
@@ -70,7 +70,19 @@ def test_build_is_interrupted_and_resumed_without_redoing_finished_raids(tmp_pat
         for raid in (0, 1):
             ds = _complete(out / f"house{house}" / f"raid{raid}")
             assert len(ds) in (10, 12) and ds.meta["raid"]["raid"] == raid
-    assert "paper (Table 2)" in stdout and "grid, sun day" in stdout
+    assert "paper: Table 2" in stdout and "grid, sun day" in stdout
+    assert "10/640 0.02" in stdout                         # house 20's grid raid beside the paper's 640
+
+
+def test_the_summary_sets_each_house_and_raid_beside_the_paper():
+    raids = [{"house": 15, "raid": 0, "captures": 1870}, {"house": 20, "raid": 0, "captures": 320},
+             {"house": 20, "raid": 1, "captures": 326}, {"house": 29, "raid": 0, "captures": 480}]
+    text = summary_table({"raids": raids})
+    rows = {line.split()[0]: line for line in text.splitlines() if line.strip()}
+    assert rows["15"].split()[1:] == ["1870/1870", "1.00", "-"]
+    assert rows["20"].split()[1:] == ["320/640", "0.50", "326/163", "2.00"]
+    assert "1.00 (0.50-1.50)" in rows["0"] and "2670" in rows["0"] and "2830" in rows["0"]   # 1870+640+320
+    assert "2.00 (2.00-2.00)" in rows["1"]
 
 
 def test_a_half_written_raid_is_redone_from_an_empty_folder(tmp_path):

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from evaldata import small_dataset
 
 from ravh_sim.errors import UserError
 from ravh_sim.eval.descriptors import BASELINE, CELLS, ORIENTATIONS, describe, gradient_grid, load_descriptor
@@ -54,3 +55,16 @@ def test_inconsistent_or_non_finite_vectors_are_refused():
         describe([_scene(1), _scene(2)], lambda im: np.ones(next(sizes)))
     with pytest.raises(UserError, match="non-finite"):
         describe([_scene(1)], lambda im: np.array([1.0, np.nan]))
+
+
+def test_the_cnn_descriptor_finds_each_view_again_in_dimmer_light(tmp_path_factory):
+    pytest.importorskip("torch")
+    pytest.importorskip("efficientnet_lite_pytorch")
+    from ravh_sim.dataset.api import Dataset
+    from ravh_sim.eval.cnn_descriptor import GRID, efficientnet_lite0
+    views = [s.rgb for s in Dataset(small_dataset(tmp_path_factory))]      # 2 spots x 6 headings, house 20
+    v = efficientnet_lite0(views[0])
+    assert v.shape == (GRID * GRID * 1280,) and np.array_equal(v, efficientnet_lite0(views[0]))
+    dim = [(im.astype(np.float32) * 0.5).astype(np.uint8) for im in views]
+    similarity = describe(dim, efficientnet_lite0) @ describe(views, efficientnet_lite0).T
+    assert np.array_equal(np.argmax(similarity, axis=1), np.arange(len(views)))   # each view is itself

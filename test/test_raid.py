@@ -65,7 +65,9 @@ def test_grid_raid_turns_ten_captures_per_node(tmp_path, raid_env):
         assert np.linalg.norm(group[:, :2] - group[0, :2], axis=1).max() < 0.1      # turning on the spot
         turns = np.sort((group[:, 2] - group[0, 2]) % (2 * math.pi))
         assert np.allclose(np.diff(turns), 2 * math.pi / 10, atol=math.radians(5))
-    assert all(0.3 < d < 1.2 for d in np.linalg.norm(np.diff(nodes, axis=0), axis=1))  # lattice neighbours
+    # lattice neighbours, distinct stops: the paper's node rule moves a point the robot cannot reach to the
+    # nearest spot it can, so stops near walls lie closer than the 0.5 m lattice
+    assert all(0.15 < d < 1.2 for d in np.linalg.norm(np.diff(nodes, axis=0), axis=1))
 
 
 def test_presets_follow_the_paper():

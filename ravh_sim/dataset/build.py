@@ -18,6 +18,7 @@ import json
 import multiprocessing
 import os
 import shutil
+import statistics
 import sys
 import time
 from collections.abc import Callable, Iterable, Iterator
@@ -29,13 +30,11 @@ from typing import Any
 from ravh_sim.dataset import layout
 from ravh_sim.dataset.raid import PRESETS, preset_settings, run_raid
 from ravh_sim.errors import UserError
+from ravh_sim.paper import RAID_COLUMNS, TABLE2, table2
 
 ENGINES = ("direct", "ros")
 POLL_S = 0.5
 RAY_RETRIES = 2                         # a raid whose task fails is run again this many times
-# The paper's dataset (Table 2): 5 raids in each of 30 houses, about 113,000 captures in all.
-PAPER_RAIDS = 150
-PAPER_CAPTURES = 113_000
 
 
 @dataclass(frozen=True, order=True)
@@ -279,24 +278,35 @@ def _lines(path: Path) -> int:
 
 # ---------------------------------------------------------------------------- the report
 
-def summary_table(result: dict[str, Any]) -> str:
-    """Captures per preset beside the paper's dataset (Table 2's total, scaled to these raids)."""
-    by_raid: dict[int, list[dict[str, Any]]] = {}
-    for s in result["raids"]:
-        by_raid.setdefault(int(s["raid"]), []).append(s)
-    lines = [f"{'raid':<5}{'preset':<40}{'raids':>6}{'captures':>10}{'per raid':>10}"]
-    for raid, rows in sorted(by_raid.items()):
+def summary_table(result: dict[str, Any], paper: dict[int, dict[int, int]] | None = None) -> str:
+    """Captures per house and raid beside the paper's Table 2 (ours / paper = ratio), then per raid
+    preset: totals, and the median and range of the per-house ratios."""
+    paper = table2() if paper is None else paper
+    ours = {(int(s["house"]), int(s["raid"])): int(s["captures"]) for s in result["raids"]}
+    raids = sorted({raid for _, raid in ours})
+    cell = 20
+    lines = [f"{'house':<6}" + "".join(f"{f'raid {r} ({RAID_COLUMNS[r]})':>{cell}}" for r in raids)]
+    for house in sorted({h for h, _ in ours}):
+        row = f"{house:<6}"
+        for raid in raids:
+            n, theirs = ours.get((house, raid)), paper.get(house, {}).get(raid)
+            text = "-" if n is None else f"{n}" if not theirs else f"{n}/{theirs} {n / theirs:.2f}"
+            row += f"{text:>{cell}}"
+        lines.append(row)
+    lines.append("")
+    lines.append(f"{'raid':<5}{'preset':<40}{'raids':>6}{'captures':>10}{'paper':>9}{'ratio median (range)':>24}")
+    for raid in raids:
         p = PRESETS[raid]
         preset = (f"{p.behaviour}, sun {p.sun}, ceiling {p.ceiling}, lamps {p.lamps}"
                   + (", random look" if p.paint == "random" else ""))
-        captures = sum(r["captures"] for r in rows)
-        lines.append(f"{raid:<5}{preset:<40}{len(rows):>6}{captures:>10}{captures / len(rows):>10.0f}")
-    n = len(result["raids"])
-    total = sum(r["captures"] for r in result["raids"])
-    paper_per_raid = PAPER_CAPTURES / PAPER_RAIDS
-    lines.append(f"{'all':<45}{n:>6}{total:>10}{total / max(n, 1):>10.0f}")
-    lines.append(f"{'paper (Table 2), the same number of raids':<45}{n:>6}{paper_per_raid * n:>10.0f}"
-                 f"{paper_per_raid:>10.0f}   (~{PAPER_CAPTURES:,} captures in {PAPER_RAIDS} raids)")
+        houses = [h for h, r in ours if r == raid]
+        total = sum(ours[h, raid] for h in houses)
+        compared = [h for h in houses if paper.get(h, {}).get(raid)]
+        ratios = sorted(ours[h, raid] / paper[h][raid] for h in compared)
+        paper_total = sum(paper[h][raid] for h in compared)
+        spread = (f"{statistics.median(ratios):.2f} ({ratios[0]:.2f}-{ratios[-1]:.2f})" if ratios else "-")
+        lines.append(f"{raid:<5}{preset:<40}{len(houses):>6}{total:>10}{paper_total:>9}{spread:>24}")
+    lines.append(f"paper: Table 2 ({TABLE2.name}), raid 0 = its grid column, raids 1-4 = W1-W4")
     return "\n".join(lines)
 
 
@@ -323,7 +333,23 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--max-nodes", type=int, default=0, help="grid raids: visit only N nodes (0: all)")
     p.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     p.set_defaults(func=cmd_build)
+    e = commands.add_parser("export", help="datasets under DIR in a detector-training format (COCO)")
+    e.add_argument("dir", type=Path, metavar="DIR", help="a dataset folder, or a build's OUT with many")
+    e.add_argument("--format", choices=("coco",), required=True,
+                   help="coco: instances.json (boxes, RLE masks, categories) + semantic/ class images")
+    e.add_argument("--out", type=Path, default=None, help="where instances.json goes (default DIR/coco)")
+    e.add_argument("--min-pixels", type=int, default=1, help="annotate objects covering at least N pixels")
+    e.set_defaults(func=cmd_export)
     dataset.set_defaults(func=lambda args: dataset.print_help() or 2)
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    from ravh_sim.dataset.coco import INSTANCES_JSON, export_coco
+    out = args.out or args.dir / "coco"
+    counts = export_coco(args.dir, out, args.min_pixels)
+    print(f"{counts['images']} images, {counts['annotations']} annotations from {counts['datasets']} datasets: "
+          f"{out / INSTANCES_JSON} (semantic class images in each dataset's semantic/)")
+    return 0
 
 
 def cmd_build(args: argparse.Namespace) -> int:

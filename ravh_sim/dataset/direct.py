@@ -33,7 +33,15 @@ import yaml
 
 from ravh_sim.behaviours.grid import GridSweep
 from ravh_sim.behaviours.wanderer import Wanderer
-from ravh_sim.behaviours.waypoints import ORDERS, Layout, grid_nodes, light_waypoints
+from ravh_sim.behaviours.waypoints import (
+    NODE_RULES,
+    ORDERS,
+    PAPER_AGENT_RADIUS,
+    Layout,
+    grid_nodes,
+    light_waypoints,
+    paper_grid_nodes,
+)
 from ravh_sim.dataset import layout
 from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
@@ -48,10 +56,13 @@ WRITES_IN_FLIGHT = 4             # captures encoded and written behind the rende
 
 @dataclass(frozen=True)
 class GridSpec:
-    """The Grid behaviour: lattice nodes every ``spacing`` m, ``captures_per_node`` in a full turn."""
+    """The Grid behaviour: lattice nodes every ``spacing`` m, ``captures_per_node`` in a full turn.
+    ``nodes``: "paper" (the original's rule, the paper's node counts) or "cover" (nodes on the robot's
+    own free space); see :mod:`ravh_sim.behaviours.waypoints`."""
     spacing: float = 0.5
     captures_per_node: int = 10
     max_nodes: int = 0                      # visit only the first N nodes (0: all)
+    nodes: str = "paper"
     name = "grid"
 
 
@@ -93,6 +104,8 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
         raise UserError(f"unknown behaviour {behaviour!r}; valid: {', '.join(BEHAVIOURS)} or a spec")
     if isinstance(spec, WandererSpec) and spec.order not in ORDERS:
         raise UserError(f"wanderer order must be one of {', '.join(ORDERS)}, got {spec.order!r}")
+    if isinstance(spec, GridSpec) and spec.nodes not in NODE_RULES:
+        raise UserError(f"grid nodes must be one of {', '.join(NODE_RULES)}, got {spec.nodes!r}")
     out = Path(out)
     start, cpu_start = time.monotonic(), time.process_time()
     with DatasetWriter(out) as writer:         # refuses a folder with a dataset before writing anything
@@ -171,7 +184,11 @@ class _Session:
         follower = PathFollower(robot, rt.navigation, self.agent.profile)
         layout, grid, start = Layout.of(rt.house), rt.navigation.map(), robot.pose[:2]
         if isinstance(spec, GridSpec):
-            nodes = grid_nodes(layout, grid, start, spec.spacing)
+            if spec.nodes == "paper":
+                walkable = rt.navigation.walkable(PAPER_AGENT_RADIUS)
+                nodes = paper_grid_nodes(layout, walkable, grid, start, spec.spacing)
+            else:
+                nodes = grid_nodes(layout, grid, start, spec.spacing)
             return GridSweep(follower, nodes[:spec.max_nodes] if spec.max_nodes > 0 else nodes,
                              spec.captures_per_node)
         return Wanderer(follower, light_waypoints(layout, grid, start), spec.order, spec.capture_period,

@@ -6,6 +6,8 @@ import json
 import sys
 from pathlib import Path
 
+from ravh_sim.paper import TABLE3
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the evaluation commands to ``ravh``'s subcommands."""
@@ -20,8 +22,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     evaluation = sub.add_parser("eval", help="the paper's benchmarks: semantic maps (Table 3), localization (Table 4)")
     which = evaluation.add_subparsers(metavar="BENCHMARK")
     p = which.add_parser("semantic-map", help="precision/recall of semantic maps against the ground truth")
-    p.add_argument("--dataset", type=Path, nargs="+", required=True, help="dataset folders (one per house)")
-    p.add_argument("--map", type=Path, nargs="+", required=True, help="semantic-map files, one per dataset")
+    p.add_argument("--dataset", type=Path, nargs="+", default=[], help="dataset folders (one per house)")
+    p.add_argument("--map", type=Path, nargs="+", default=[], help="semantic-map files, one per dataset")
+    p.add_argument("--paper", type=Path, nargs="?", const=TABLE3, default=None, metavar="TSV",
+                   help="set the paper's Table 3 row beside each house (default TSV: config/paper/)")
+    p.add_argument("--paper-protocol", action="store_true",
+                   help="record one wanderer raid with a random appearance per house (--houses) into --out, "
+                        "map it with --mappers and print Table 3's columns beside the paper's")
+    p.add_argument("--houses", default="1-30", help="--paper-protocol: houses, e.g. 1-30 or 20,29")
+    p.add_argument("--mappers", default="oracle,degraded", help="--paper-protocol: oracle, degraded or both")
+    p.add_argument("--seed", type=int, default=0, help="--paper-protocol: seed of the raids and the degraded mapper")
     p.add_argument("--iou", type=float, default=None,
                    help="overlap threshold (intersection / smaller volume; default 0.5)")
     p.add_argument("--out", type=Path, default=None, help="folder for table3.json/.txt and the plan pictures")
@@ -51,18 +61,42 @@ def cmd_semantic_map(args: argparse.Namespace) -> int:
 
 def cmd_eval_semantic_map(args: argparse.Namespace) -> int:
     from ravh_sim.errors import UserError
-    from ravh_sim.eval.semantic_eval import DEFAULT_THRESHOLD, evaluate_datasets, format_table
-    if len(args.dataset) != len(args.map):
-        raise UserError(f"give one --map per --dataset ({len(args.dataset)} datasets, {len(args.map)} maps)")
+    from ravh_sim.eval.semantic_eval import DEFAULT_THRESHOLD, evaluate_datasets, format_beside_paper, format_table
+    from ravh_sim.paper import read_tsv
     threshold = DEFAULT_THRESHOLD if args.iou is None else args.iou
     if not 0.0 < threshold <= 1.0:
         raise UserError(f"--iou must be in (0, 1], got {threshold}")
+    if args.paper_protocol:
+        return _paper_protocol(args, threshold, args.paper or TABLE3)
+    if not args.dataset or len(args.dataset) != len(args.map):
+        raise UserError(f"give one --map per --dataset ({len(args.dataset)} datasets, {len(args.map)} maps), "
+                        "or --paper-protocol")
     doc = evaluate_datasets(list(zip(args.dataset, args.map)), threshold, args.out)
     text = format_table(doc)
+    if args.paper is not None:
+        text += "\n\n" + format_beside_paper(doc, {int(r["house"]): r for r in read_tsv(args.paper)})
     if args.out is not None:
         (args.out / "table3.json").write_text(json.dumps(doc, indent=1) + "\n")
         (args.out / "table3.txt").write_text(text + "\n")
     print(json.dumps(doc, indent=1) if args.json else text)
+    return 0
+
+
+def _paper_protocol(args: argparse.Namespace, threshold: float, paper_path: Path) -> int:
+    from ravh_sim.dataset.build import parse_numbers
+    from ravh_sim.errors import UserError
+    from ravh_sim.eval.mappers import MAPPERS
+    from ravh_sim.eval.table3 import run_protocol
+    from ravh_sim.world.house import available_houses
+    if args.out is None:
+        raise UserError("--paper-protocol needs --out (the raids are recorded there and reused)")
+    houses = parse_numbers(args.houses, available_houses(), "houses")
+    mappers = [m.strip() for m in args.mappers.split(",") if m.strip()]
+    if not mappers or set(mappers) - set(MAPPERS):
+        raise UserError(f"--mappers: {args.mappers!r}; valid: {', '.join(MAPPERS)}")
+    run_protocol(houses, args.out, mappers, args.seed, threshold, paper_path,
+                 progress=lambda text: print(text, file=sys.stderr, flush=True))
+    print((args.out / "table3_paper.txt").read_text(), end="")
     return 0
 
 

@@ -145,9 +145,14 @@ class MapFuser:
 def build_map(dataset: Dataset, detect: Callable[[Sample], list[Detection]]) -> SemanticMap:
     """Run ``detect`` on every capture of ``dataset`` and fuse the detections into a semantic map."""
     fuser = MapFuser(dataset)
+    detections = 0
     for sample in dataset:
-        fuser.add(sample, detect(sample))
-    return fuser.semantic_map()
+        found = detect(sample)
+        detections += len(found)
+        fuser.add(sample, found)
+    semantic_map = fuser.semantic_map()
+    semantic_map.detections = detections
+    return semantic_map
 
 
 def _same_object(a: _Fused, b: _Fused) -> bool:

@@ -101,7 +101,7 @@ def perturb(semantic_map: SemanticMap, seed: int, errors: Degradation) -> Semant
         shift = rng.normal(0.0, errors.center_sigma, 3)
         scale = np.exp(rng.normal(0.0, errors.size_sigma, 3))
         boxes.append(replace(b, center=float3(np.add(b.center, shift)), size=float3(np.multiply(b.size, scale))))
-    return SemanticMap(semantic_map.house, boxes)
+    return SemanticMap(semantic_map.house, boxes, semantic_map.detections)
 
 
 MAPPERS = ("oracle", "degraded")

@@ -105,9 +105,10 @@ class HouseResult:
     by_type: dict[str, Counts]
     box_correct: list[bool]                       # per map box
     object_found: dict[int, bool]                 # detectable object id -> found
+    detections: int | None = None                 # detections fused into the map (when counted)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"house": self.house, **self.total.to_dict(),
+        return {"house": self.house, "detections": self.detections, **self.total.to_dict(),
                 "by_type": {t: c.to_dict() for t, c in sorted(self.by_type.items())}}
 
 
@@ -142,7 +143,7 @@ def evaluate(semantic_map: SemanticMap, truth: Sequence[GroundTruthObject], hous
     total = Counts()
     for c in by_type.values():
         total.add(c)
-    return HouseResult(house, total, dict(by_type), [bool(js) for js in matches], found)
+    return HouseResult(house, total, dict(by_type), [bool(js) for js in matches], found, semantic_map.detections)
 
 
 def table(results: Sequence[HouseResult]) -> dict[str, Any]:
@@ -178,6 +179,49 @@ def format_table(doc: dict[str, Any]) -> str:
     lines.append("by type (all houses)")
     lines.extend(row(t, c) for t, c in doc["by_type"].items())
     return "\n".join(lines)
+
+
+PAPER_COLUMNS = ("CNN detections", "boxes", "detected objects", "precision %", "recall %")
+
+
+def paper_columns(row: dict[str, Any]) -> tuple[Any, ...]:
+    """One of our house rows as Table 3's columns (detected objects: the objects a box found)."""
+    return (row.get("detections"), row["boxes"], row["found"], _pct(row["precision"]), _pct(row["recall"]))
+
+
+def format_beside_paper(doc: dict[str, Any], paper: dict[int, dict[str, str]], label: str = "ours") -> str:
+    """Table 3's columns per house, our row and the paper's (``paper``: house -> its TSV row) beside it,
+    then the mean of each over the houses in both."""
+    head = f"{'house':<7}{'':<16}" + "".join(f"{c:>17}" for c in PAPER_COLUMNS)
+    lines = [head]
+    ours_rows, theirs_rows = [], []
+    for h in doc["houses"]:
+        ours = paper_columns(h)
+        lines.append(f"{h['house']:<7}{label:<16}" + "".join(f"{_cell(v):>17}" for v in ours))
+        row = paper.get(int(h["house"]))
+        if row is not None:
+            theirs = (int(row["cnn_detections"]), int(row["detection_boxes"]), int(row["detected_objects"]),
+                      float(row["precision_pct"]), float(row["recall_pct"]))
+            lines.append(f"{'':<7}{'paper':<16}" + "".join(f"{_cell(v):>17}" for v in theirs))
+            ours_rows.append(ours)
+            theirs_rows.append(theirs)
+    for name, rows in ((label, ours_rows), ("paper", theirs_rows)):
+        means = [_mean([r[k] for r in rows]) for k in range(len(PAPER_COLUMNS))]
+        lines.append(f"{'mean':<7}{name:<16}" + "".join(f"{_cell(v):>17}" for v in means))
+    return "\n".join(lines)
+
+
+def _pct(v: float | None) -> float | None:
+    return None if v is None else round(100 * v, 1)
+
+
+def _mean(values: list[Any]) -> float | None:
+    known = [v for v in values if v is not None]
+    return round(float(np.mean(known)), 1) if known else None
+
+
+def _cell(v: Any) -> str:
+    return "-" if v is None else f"{v:.1f}" if isinstance(v, float) else str(v)
 
 
 # --------------------------------------------------------------------------- Fig. 9

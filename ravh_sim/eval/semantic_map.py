@@ -2,11 +2,12 @@
 
 A semantic map is a JSON file (``ravh_sim/semantic_map@1``)::
 
-    {"format": "ravh_sim/semantic_map@1", "house": 20,
+    {"format": "ravh_sim/semantic_map@1", "house": 20, "detections": 212,
      "boxes": [{"type": "Chair", "center": [x, y, z], "size": [sx, sy, sz], "yaw": 0.3,
                 "score": 0.9, "captures": [12, 13]}, ...]}
 
-``center`` is the box centre in metres in the house/map frame (z up, the floor of the ground storey
+``detections`` (optional) is how many detections the mapper fused into the boxes (Table 3's "CNN
+detections"). ``center`` is the box centre in metres in the house/map frame (z up, the floor of the ground storey
 at z = 0 as in the footprint); ``size`` the full extents along the box's own x, y, z axes; ``yaw`` the
 rotation of the box's x axis about +z (radians). ``score`` (default 1) and ``captures`` (the dataset
 capture indices the box came from, default []) are optional. ``type`` uses the footprint's object
@@ -71,9 +72,11 @@ class LabelledBox:
 class SemanticMap:
     house: int
     boxes: list[LabelledBox]
+    detections: int | None = None          # detections fused into the boxes, when the mapper counted them
 
     def to_dict(self) -> dict[str, Any]:
-        return {"format": FORMAT, "house": self.house, "boxes": [b.to_dict() for b in self.boxes]}
+        counted = {} if self.detections is None else {"detections": self.detections}
+        return {"format": FORMAT, "house": self.house, **counted, "boxes": [b.to_dict() for b in self.boxes]}
 
 
 def write_map(semantic_map: SemanticMap, path: str | Path) -> None:
@@ -96,7 +99,11 @@ def read_map(path: str | Path) -> SemanticMap:
         raise FileFieldError(path, "house", "expected the house number (integer)")
     if not isinstance(data.get("boxes"), list):
         raise FileFieldError(path, "boxes", "expected a list of boxes")
-    return SemanticMap(data["house"], [_box(path, f"boxes[{i}]", b) for i, b in enumerate(data["boxes"])])
+    detections = data.get("detections")
+    if detections is not None and (not isinstance(detections, int) or isinstance(detections, bool) or detections < 0):
+        raise FileFieldError(path, "detections", "expected a count (integer >= 0)")
+    return SemanticMap(data["house"], [_box(path, f"boxes[{i}]", b) for i, b in enumerate(data["boxes"])],
+                       detections)
 
 
 def _box(path: str | Path, where: str, b: Any) -> LabelledBox:

@@ -46,6 +46,12 @@ class Navigation:
             self.house, doors, models, radius=self.profile.radius, height=self.profile.height,
             resolution=self.resolution))
 
+    def walkable(self, radius: float) -> Grid:
+        """Free space for a disc of ``radius`` at the robot's height (the paper's grid rule bakes its
+        walkable area for a 0.1 m agent, narrower than our robot)."""
+        return self._current(f"walkable {radius}", lambda doors, models: free_space(
+            self.house, doors, models, radius=radius, height=self.profile.height, resolution=self.resolution))
+
     def obstacle_map(self) -> Grid:
         """The uninflated obstacle map at laser height for the current doors and models."""
         return self._current("obstacles", lambda doors, models: obstacle_map(

@@ -104,9 +104,8 @@ class RosNavigation:
         return plan_path(self.map(), start, goal)
 
 
-def which_agent(node: Node, wanted: str | None) -> tuple[str, bool, str]:
-    """(name, first, profile) of the agent to drive: ``wanted`` or else the sim's first agent, as the
-    latched footprint lists them (the first uses the plain topic names, whatever it is called)."""
+def read_footprint(node: Node) -> dict[str, Any]:
+    """The sim's latched footprint (house number, settings, instances)."""
     import rclpy
     got: list[str] = []
     sub = node.create_subscription(String, n.GROUND_TRUTH, lambda m: got.append(m.data), LATCHED_QOS)
@@ -117,7 +116,13 @@ def which_agent(node: Node, wanted: str | None) -> tuple[str, bool, str]:
     if not got:
         raise UserError(f"no sim node published {n.GROUND_TRUTH} within {STARTUP_TIMEOUT_S:.0f} s "
                         f"(is `ravh sim` running on ROS_DOMAIN_ID {os.environ.get('ROS_DOMAIN_ID', '0')}?)")
-    footprint = json.loads(got[0])
+    return json.loads(got[0])
+
+
+def which_agent(node: Node, wanted: str | None, footprint: dict[str, Any] | None = None) -> tuple[str, bool, str]:
+    """(name, first, profile) of the agent to drive: ``wanted`` or else the sim's first agent, as the
+    latched footprint lists them (the first uses the plain topic names, whatever it is called)."""
+    footprint = read_footprint(node) if footprint is None else footprint
     agents = n.footprint_agents(footprint)
     if not agents:
         raise UserError("the sim has no agents")
@@ -139,14 +144,16 @@ def layout_from_ground_truth(client: RavhClient) -> Layout:
 
 
 class BehaviourNode(Node):
-    """Hosts one behaviour: ``make_behaviour(follower, layout, grid, start_xy)`` builds it once the sim is up."""
+    """Hosts one behaviour: ``make_behaviour(follower, layout, grid, start_xy, footprint)`` builds it once
+    the sim is up."""
 
-    def __init__(self, name: str, make_behaviour: Callable[[PathFollower, Layout, Grid, tuple], Any],
+    def __init__(self, name: str, make_behaviour: Callable[[PathFollower, Layout, Grid, tuple, dict], Any],
                  agent: str | None = None, profile: str | None = None, log_path: Path | None = None,
                  wait_recorder: bool = False, lockstep: bool = False) -> None:
         """``agent``: None drives the sim's first agent; ``profile``: None takes the agent's from the sim."""
         super().__init__(name, parameter_overrides=[Parameter("use_sim_time", value=True)])
-        agent, first, agent_profile = which_agent(self, agent)
+        self.footprint = read_footprint(self)
+        agent, first, agent_profile = which_agent(self, agent, self.footprint)
         self.robot = RosRobot(self, agent, first, lockstep)
         self.navigation = RosNavigation(self)
         self.client = RavhClient(self)
@@ -166,7 +173,7 @@ class BehaviourNode(Node):
         self._wait_for_sim()
         layout = layout_from_ground_truth(self.client)
         follower = PathFollower(self.robot, self.navigation, load_profile(profile or agent_profile))
-        self.behaviour = make_behaviour(follower, layout, self.navigation.map(), self.robot.pose[:2])
+        self.behaviour = make_behaviour(follower, layout, self.navigation.map(), self.robot.pose[:2], self.footprint)
         self._last_t: float | None = None
         self._rooms_seen: set[str] = set()
         self._granted: float | None = 0.0            # lockstep: sim time granted and not reached yet

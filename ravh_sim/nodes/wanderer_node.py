@@ -17,7 +17,7 @@ def make_node(argv: list[str]) -> BehaviourNode:
     p.add_argument("--seed", type=int, default=0, help="seed of the random order")
     args = p.parse_args(argv)
 
-    def make(follower, layout, grid, start) -> Any:
+    def make(follower, layout, grid, start, _footprint) -> Any:
         return Wanderer(follower, light_waypoints(layout, grid, start), args.order, args.capture_period,
                         args.seed)
 

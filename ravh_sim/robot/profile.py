@@ -18,6 +18,7 @@ from ravh_sim.errors import UnknownNameError
 from ravh_sim.paths import ROBOTS_DIR
 from ravh_sim.render.backend import QUALITIES
 from ravh_sim.schema import FINITE, Strict, load_yaml, read_text, validate
+from ravh_sim.sensors.imaging import SensorModel
 
 
 @dataclass(frozen=True)
@@ -88,6 +89,7 @@ class RobotProfile:
     laser: LaserSpec
     camera: CameraSpec
     camera_effects: tuple[tuple[str, Any], ...] = ()   # CameraOptions fields set by the profile
+    camera_sensor: SensorModel | None = None            # None: the ideal camera (no sensor model)
 
 
 def available_profiles() -> list[str]:
@@ -147,6 +149,34 @@ class _Effects(Strict):
     manual_exposure: Annotated[float, Field(gt=0.0, le=100.0), FINITE] | None = None
 
 
+class _Sensor(Strict):
+    """The camera sensor model (ravh_sim.sensors.imaging.SensorModel); a field left out takes its default."""
+    enabled: bool = True
+    exposure_min: Annotated[float, Field(gt=0.0, le=1.0), FINITE] | None = None        # s
+    exposure_max: Annotated[float, Field(gt=0.0, le=1.0), FINITE] | None = None        # s
+    gain_max: Annotated[float, Field(ge=1.0, le=1000.0), FINITE] | None = None
+    full_well: Annotated[float, Field(gt=0.0, le=1e7), FINITE] | None = None           # e-
+    read_noise: Annotated[float, Field(ge=0.0, le=1000.0), FINITE] | None = None       # e- rms
+    sensitivity: Annotated[float, Field(gt=0.0, le=1e12), FINITE] | None = None       # e- / s / radiance
+    target: Annotated[float, Field(gt=0.0, le=1.0), FINITE] | None = None
+    adc_bits: Annotated[int, Field(ge=1, le=16)] | None = None
+    white_balance: bool | None = None
+    white_balance_limit: Annotated[float, Field(ge=1.0, le=100.0), FINITE] | None = None
+    reference_exposure: Annotated[float, Field(gt=0.0, le=100.0), FINITE] | None = None
+
+    @model_validator(mode="after")
+    def _ordered(self) -> _Sensor:
+        model = self.model()
+        if model is not None and model.exposure_min > model.exposure_max:
+            raise ValueError(f"exposure_min {model.exposure_min} must not exceed exposure_max {model.exposure_max}")
+        return self
+
+    def model(self) -> SensorModel | None:
+        if not self.enabled:
+            return None
+        return SensorModel(**self.model_dump(exclude_none=True, exclude={"enabled"}))
+
+
 class _Camera(Strict):
     height: Length
     pitch: Annotated[float, Field(ge=-90.0, le=90.0), FINITE]
@@ -161,6 +191,7 @@ class _Camera(Strict):
     rate: Rate
     quality: Literal[QUALITIES] = "realistic"         # type: ignore[valid-type]
     effects: _Effects = _Effects()
+    sensor: _Sensor = _Sensor(enabled=False)
 
     @model_validator(mode="after")
     def _ordered(self) -> _Camera:
@@ -204,4 +235,5 @@ def load_profile(name_or_path: str | Path = DEFAULT_PROFILE) -> RobotProfile:
         camera=CameraSpec(cam.height, cam.pitch, cam.forward, cam.width, cam.height_px, cam.sensor_width,
                           cam.sensor_height, cam.focal_length, cam.near, cam.far, cam.rate, cam.quality),
         camera_effects=tuple(sorted(effects.model_dump(exclude_none=True).items())),
+        camera_sensor=cam.sensor.model(),
     )

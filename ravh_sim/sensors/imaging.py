@@ -1,12 +1,18 @@
-"""What a real camera does to a perfect image: motion blur, lens distortion, noise and JPEG.
+"""What a real camera does to a perfect image: exposure, sensor noise, motion blur, lens distortion and JPEG.
 
 Each effect is a plain function (or, for distortion, a precomputed remap) over numpy images, applied
 by the smart camera in the physical order: blur during the exposure, then the lens, then sensor
 noise, then compression. Randomness comes from the caller's generator, so images are reproducible.
+
+:class:`SensorModel` is the camera's sensor as a whole (the realistic profile's; off in the ideal
+camera): it takes linear scene radiance and makes the 8-bit image a real camera would, so a dim room
+costs what it costs a real one (longer exposure and its motion blur, gain and its noise, or a dark
+image when both are at their limits) instead of being lifted to daylight for free.
 """
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -52,21 +58,136 @@ def motion_blur(rgb: np.ndarray, K: np.ndarray, linear: float, angular: float, e
     at ``linear`` m/s zooms it about the principal point by linear * exposure / ``distance`` (the
     scene's typical depth). The image is the mean of copies along that sweep, centred on the pose.
     """
+    blurred = _sweep(rgb, K, linear, angular, exposure, distance)
+    return rgb if blurred is None else np.clip(blurred + 0.5, 0, 255).astype(np.uint8)
+
+
+def _sweep(image: np.ndarray, K: np.ndarray, linear: float, angular: float, exposure: float,
+           distance: float) -> np.ndarray | None:
+    """float32 mean of ``image`` along the motion sweep of :func:`motion_blur` (None: under a pixel)."""
     fx, cx, cy = K[0, 0], K[0, 2], K[1, 2]
     shift = fx * angular * exposure
     zoom = linear * exposure / max(distance, 0.1)
     reach = max(abs(shift), abs(zoom) * math.hypot(cx, cy))
     samples = min(MAX_BLUR_SAMPLES, int(math.ceil(reach)) + 1)
     if samples < 2:
-        return rgb
-    acc = np.zeros(rgb.shape, np.float32)
-    h, w = rgb.shape[:2]
+        return None
+    acc = np.zeros(image.shape, np.float32)
+    h, w = image.shape[:2]
     for t in np.linspace(-0.5, 0.5, samples):
         scale = 1.0 + zoom * t
         warp = np.array([[scale, 0.0, (1 - scale) * cx + shift * t],
                          [0.0, scale, (1 - scale) * cy]], np.float32)
-        acc += cv2.warpAffine(rgb, warp, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
-    return np.clip(acc / samples + 0.5, 0, 255).astype(np.uint8)
+        acc += cv2.warpAffine(image, warp, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+    return acc / samples
+
+
+# ---------------------------------------------------------------------------- the sensor
+
+DAYLIT_LUMINANCE = 0.5        # mean linear luminance of a daylit room in the renderer's light units
+LUMA = np.array([0.2126, 0.7152, 0.0722], np.float32)       # Rec. 709 luminance of linear RGB
+
+
+@dataclass(frozen=True)
+class Exposure:
+    """What the auto-exposure chose for one frame, and what came of it."""
+    time: float               # s
+    gain: float               # analogue gain (1 = base ISO)
+    signal: float             # mean of the image in full-scale units (the AE's target when reachable)
+    white_balance: tuple[float, float, float]    # per-channel gains applied
+
+
+@dataclass(frozen=True)
+class SensorModel:
+    """A camera sensor and its image pipeline. Units: radiance in the renderer's linear light units,
+    charge in electrons (e-).
+
+    Auto-exposure meters the mean luminance and asks for ``target`` of full scale: it lengthens the
+    exposure up to ``exposure_max`` first (longer frames blur), then raises the gain up to ``gain_max``;
+    past both the image stays dark. The pixel collects radiance * sensitivity * time electrons, with
+    photon shot noise (Poisson, sqrt of the charge) and ``read_noise``, clips at ``full_well``; the gain
+    amplifies signal and noise alike and the ADC clips and quantises to ``adc_bits``. So noise relative
+    to signal grows as light falls (fewer electrons, more gain). White balance is grey-world, limited to
+    ``white_balance_limit``; the output is the renderer's ACES curve and sRGB encoding. The default
+    sensitivity makes a daylit room a 1/100 s exposure at gain 1.
+    """
+    exposure_min: float = 1e-4
+    exposure_max: float = 1 / 30
+    gain_max: float = 16.0
+    full_well: float = 6000.0
+    read_noise: float = 3.0
+    sensitivity: float = 0.18 * 6000.0 / (DAYLIT_LUMINANCE * 0.01)     # e- per second per unit radiance
+    target: float = 0.18
+    adc_bits: int = 10
+    white_balance: bool = True
+    white_balance_limit: float = 2.0
+    reference_exposure: float = 1.0     # the renderer's fixed exposure of the frames fed to from_rendered
+
+    def auto_exposure(self, radiance: np.ndarray) -> tuple[float, float]:
+        """(exposure time s, gain) for a (H, W, 3) linear radiance image."""
+        metered = max(float(np.mean(radiance @ LUMA)), 1e-9)
+        wanted = self.target * self.full_well / (metered * self.sensitivity)      # time * gain
+        time = float(np.clip(wanted, self.exposure_min, self.exposure_max))
+        return time, float(np.clip(wanted / time, 1.0, self.gain_max))
+
+    def expose(self, radiance: np.ndarray, rng: np.random.Generator, K: np.ndarray | None = None,
+               velocity: tuple[float, float] = (0.0, 0.0), distance: float = 2.0) -> tuple[np.ndarray, Exposure]:
+        """The 8-bit RGB image of linear ``radiance`` (H, W, 3), and the exposure chosen; ``velocity``
+        (v m/s, w rad/s) blurs over the exposure time (needs ``K``, the scene at ``distance`` m)."""
+        radiance = np.asarray(radiance, np.float32)
+        time, gain = self.auto_exposure(radiance)
+        if K is not None and any(velocity):
+            blurred = _sweep(radiance, K, velocity[0], velocity[1], time, distance)
+            radiance = radiance if blurred is None else blurred
+        electrons = np.maximum(radiance, 0) * np.float32(self.sensitivity * time)
+        electrons = rng.poisson(electrons).astype(np.float32)                      # photon shot noise
+        electrons += rng.standard_normal(electrons.shape, dtype=np.float32) * np.float32(self.read_noise)
+        signal = np.clip(electrons, 0, self.full_well) * np.float32(gain / self.full_well)
+        levels = float(2 ** self.adc_bits - 1)
+        signal = np.round(np.clip(signal, 0, 1) * levels) / np.float32(levels)
+        balance = (1.0, 1.0, 1.0)
+        if self.white_balance:
+            means = np.maximum(signal.reshape(-1, 3).mean(axis=0), 1e-6)
+            gains = np.clip(means[1] / means, 1 / self.white_balance_limit, self.white_balance_limit)
+            signal = np.minimum(signal * gains.astype(np.float32), 1.0)
+            balance = (float(gains[0]), float(gains[1]), float(gains[2]))
+        out = srgb_encode(aces(signal * np.float32(0.2 / self.target)))
+        rgb = np.clip(out * 255 + 0.5, 0, 255).astype(np.uint8)
+        return rgb, Exposure(time, gain, float(np.mean(signal)), balance)
+
+    def from_rendered(self, rgb: np.ndarray, rng: np.random.Generator, K: np.ndarray | None = None,
+                      velocity: tuple[float, float] = (0.0, 0.0), distance: float = 2.0
+                      ) -> tuple[np.ndarray, Exposure]:
+        """:meth:`expose` for an 8-bit frame the renderer tone-mapped at ``reference_exposure`` (its
+        curve undone first); an HDR frame from the renderer would skip that step and its 8-bit steps."""
+        return self.expose(radiance_from_rendered(rgb, self.reference_exposure), rng, K, velocity, distance)
+
+
+def aces(x: np.ndarray) -> np.ndarray:
+    """The renderer's filmic curve (Narkowicz's ACES fit), linear in, display-linear [0, 1] out."""
+    return np.clip((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0)
+
+
+def aces_inverse(y: np.ndarray) -> np.ndarray:
+    """The linear value :func:`aces` maps to ``y`` (the curve's positive root; y capped below its top)."""
+    y = np.clip(np.asarray(y, np.float64), 0.0, 0.99)
+    a, b, c = 2.43 * y - 2.51, 0.59 * y - 0.03, 0.14 * y
+    return ((-b - np.sqrt(b * b - 4 * a * c)) / (2 * a)).astype(np.float32)
+
+
+def srgb_encode(c: np.ndarray) -> np.ndarray:
+    c = np.clip(c, 0.0, 1.0)
+    return np.where(c <= 0.0031308, c * 12.92, 1.055 * np.power(c, 1 / 2.4) - 0.055)
+
+
+def srgb_decode(v: np.ndarray) -> np.ndarray:
+    v = np.asarray(v, np.float32)
+    return np.where(v <= 0.04045, v / 12.92, np.power((v + 0.055) / 1.055, 2.4)).astype(np.float32)
+
+
+def radiance_from_rendered(rgb: np.ndarray, exposure: float) -> np.ndarray:
+    """Linear radiance (H, W, 3) float32 of an 8-bit frame tone-mapped by the renderer at ``exposure``."""
+    return aces_inverse(srgb_decode(rgb.astype(np.float32) / 255.0)) / np.float32(exposure)
 
 
 class LensDistortion:
