@@ -436,6 +436,31 @@ def test_day_is_brighter_than_sunset_is_brighter_than_night(camera, appearance):
     assert sun_light(200).gain[2] > sun_light(200).gain[0]          # night is blue
 
 
+def test_the_robots_sensor_is_noisier_and_darker_at_night_and_the_ideal_camera_is_clean(world, appearance):
+    """The Giraff's camera has a sensor model (exposure and gain within limits, shot and read noise):
+    the frame-to-frame noise of a still view grows as light falls, a night room with every light off
+    stays dark (past the longest exposure and the highest gain); the ideal camera (no sensor) gives
+    the same image twice."""
+    sensor = PROFILE.camera_sensor
+    assert sensor is not None and load_profile("giraff_ideal").camera_sensor is None
+    real = SmartCamera(world, PROFILE.camera, agent="real", sensor=sensor)
+    ideal = SmartCamera(world, PROFILE.camera, agent="ideal")
+    noise, level = {}, {}
+    try:
+        for preset, lights in (("day", "on"), ("night", "on"), ("night", "off")):
+            appearance.set_sun(preset)
+            appearance.set_lights("all", lights)
+            a, b = (real.capture(3.0, 2.0, math.pi).rgb.astype(np.float32) for _ in range(2))
+            noise[preset + lights] = float(np.std(a - b)) / math.sqrt(2)
+            level[preset + lights] = float(a.mean())
+            assert np.array_equal(ideal.capture(3.0, 2.0, math.pi).rgb, ideal.capture(3.0, 2.0, math.pi).rgb)
+    finally:
+        real.close()
+        ideal.close()
+    assert noise["dayon"] > 0.5 and noise["nighton"] > 1.5 * noise["dayon"]
+    assert level["nightoff"] < 0.5 * level["dayon"]
+
+
 def test_lights_on_brighten_their_room_at_night_and_not_through_the_wall(world, appearance):
     """With the exposure fixed (a camera in manual mode), a lamp brightens its own room and leaves
     the far side of the wall, seen from the next room with the door shut, exactly as it was."""

@@ -598,10 +598,11 @@ class GLRenderer:
         adapted = EXPOSURE_REFERENCE * (average / EXPOSURE_REFERENCE) ** EXPOSURE_ADAPTATION
         return float(np.clip(EXPOSURE_KEY / adapted, *EXPOSURE_RANGE))
 
-    def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None
-               ) -> RenderedViews:
+    def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None,
+               radiance: bool = False) -> RenderedViews:
         """RGB, depth and instance images from an optical frame (rotation columns: x right, y down,
-        z forward) in the house frame; ``exposure`` fixes the exposure (None: auto-exposure)."""
+        z forward) in the house frame; ``exposure`` fixes the exposure (None: auto-exposure);
+        ``radiance``: also the HDR target (linear light, before exposure) for a sensor model."""
         self._sync()
         ctx = self.ctx
         view = view_matrix(position, rotation)
@@ -628,4 +629,8 @@ class GLRenderer:
         instance = np.frombuffer(self.instance.read(), np.int32).reshape(h, w)[::-1]
         background = instance == 0
         depth[background | (depth > self.far)] = np.nan
-        return RenderedViews(np.ascontiguousarray(rgb), depth, instance.astype(np.uint16), background)
+        linear = None
+        if radiance:
+            hdr = np.frombuffer(self.hdr.read(), np.float16).reshape(h, w, 4)[::-1, :, :3]
+            linear = np.nan_to_num(hdr.astype(np.float32), nan=0.0, posinf=0.0)
+        return RenderedViews(np.ascontiguousarray(rgb), depth, instance.astype(np.uint16), background, linear)

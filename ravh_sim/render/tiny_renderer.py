@@ -30,9 +30,10 @@ class TinyRenderer:
         self._projection = projection.T.ravel().tolist()          # column-major for pybullet
         self.lighting = Lighting(world, K, width, height)
 
-    def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None
-               ) -> RenderedViews:
-        """Views from an optical pose; ``exposure`` is ignored (the lighting pass sets the level)."""
+    def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None,
+               radiance: bool = False) -> RenderedViews:
+        """Views from an optical pose; ``exposure`` is ignored (the lighting pass sets the level), and
+        so is ``radiance`` (no linear light: a sensor model works from the 8-bit image)."""
         state = self.world.state
         sun = sun_light(state.sun_angle)
         view = view_matrix(position, rotation)

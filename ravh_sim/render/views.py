@@ -18,12 +18,14 @@ class RenderedViews:
     depth: np.ndarray                 # (H, W) float32 z-depth in metres, NaN = nothing
     instance: np.ndarray              # (H, W) uint16, 0 = nothing
     background: np.ndarray            # (H, W) bool: the outdoors (sky, ground), no body
+    radiance: np.ndarray | None = None  # (H, W, 3) float32 linear light before exposure, when asked for
 
 
 class Renderer(Protocol):
-    def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None
-               ) -> RenderedViews:
-        """The views from an optical pose; ``exposure`` fixes the exposure where the renderer meters."""
+    def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None,
+               radiance: bool = False) -> RenderedViews:
+        """The views from an optical pose; ``exposure`` fixes the exposure where the renderer meters;
+        ``radiance``: also the linear light a camera sensor integrates, where the renderer has it."""
         ...
 
     def release(self) -> None:

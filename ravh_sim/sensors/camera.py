@@ -68,6 +68,7 @@ class Frame:
     background: np.ndarray                 # (H, W) bool, no body (sky)
     position: np.ndarray                   # optical frame origin, house frame
     rotation: np.ndarray                   # optical axes as columns, house frame
+    radiance: np.ndarray | None = None     # linear light before exposure (for a sensor model)
 
 
 @dataclass
@@ -87,9 +88,10 @@ class SmartCamera:
     """A camera mounted on a robot, rendering one World."""
 
     def __init__(self, world: World, spec: CameraSpec, options: CameraOptions | None = None,
-                 agent: str = names.DEFAULT_AGENT) -> None:
+                 agent: str = names.DEFAULT_AGENT, sensor: imaging.SensorModel | None = None) -> None:
         self.world, self.spec, self.agent = world, spec, agent
         self.options = options or CameraOptions()
+        self.sensor = sensor                        # None: the ideal camera (the renderer's exposure)
         self.width, self.height = spec.width, spec.height_px
         self.K = np.array([[spec.fx, 0.0, spec.cx], [0.0, spec.fy, spec.cy], [0.0, 0.0, 1.0]])
         self.camera_info = self._camera_info()
@@ -142,8 +144,9 @@ class SmartCamera:
         position, rotation = self.optical_pose(x, y, yaw, floor_z)
         if self.renderer is None:
             raise RuntimeError("the camera was closed")
-        views = self.renderer.render(position, rotation, self.options.manual_exposure)
-        return Frame(views.rgb, views.depth, views.instance, views.background, position, rotation)
+        views = self.renderer.render(position, rotation, self.options.manual_exposure, self.sensor is not None)
+        return Frame(views.rgb, views.depth, views.instance, views.background, position, rotation,
+                     views.radiance)
 
     def take_index(self) -> int:
         """The next capture number, used up: a frame due but not rendered (nobody listening) takes
@@ -160,8 +163,14 @@ class SmartCamera:
         frame = self.render(x, y, yaw, floor_z)
         rgb, depth, instance = frame.rgb, frame.depth, frame.instance
         rng = noise_rng(self.world.state.seed, NOISE_STREAM, self.agent, index)
-        if opts.motion_blur and any(velocity):
-            distance = float(np.nanmedian(depth)) if np.isfinite(depth).any() else self.spec.far
+        distance = float(np.nanmedian(depth)) if np.isfinite(depth).any() else self.spec.far
+        if self.sensor is not None:          # exposure, blur over it, noise, white balance, clipping
+            blur = velocity if opts.motion_blur else (0.0, 0.0)
+            if frame.radiance is not None:
+                rgb, _ = self.sensor.expose(frame.radiance, rng, self.K, blur, distance)
+            else:
+                rgb, _ = self.sensor.from_rendered(rgb, rng, self.K, blur, distance)
+        elif opts.motion_blur and any(velocity):
             rgb = imaging.motion_blur(rgb, self.K, velocity[0], velocity[1], opts.exposure, distance)
         if self._lens is not None:
             rgb = self._lens.apply(rgb)
@@ -246,7 +255,8 @@ def _store(values: Mapping[str, Any]) -> Stored:
 
 
 def _build(world: World, profile: RobotProfile, agent: str) -> SmartCamera:
-    return SmartCamera(world, profile.camera, CameraOptions(**dict(profile.camera_effects)), agent)
+    return SmartCamera(world, profile.camera, CameraOptions(**dict(profile.camera_effects)), agent,
+                       profile.camera_sensor)
 
 
 def _read(camera: SmartCamera, robot: Robot) -> Capture:
