@@ -69,6 +69,11 @@ EXPOSURE_RANGE = (0.08, 5.0)          # a camera's exposure limits: night stays 
 METER_BLOCK = 16                      # pixels per side averaged by one metering texel
 
 
+class RenderError(RuntimeError):
+    """The renderer produced radiance that is not a number: a shader fault. The frame is refused
+    rather than stored, since no exposure makes such pixels right."""
+
+
 def _source(name: str) -> str:
     return (resources.files("ravh_sim.render") / "shaders" / name).read_text()
 
@@ -145,7 +150,7 @@ class GLRenderer:
         self.ldr = ctx.texture(size, 4)
         self.ldr_fbo = ctx.framebuffer([self.ldr])
         meter_size = (-(-width // METER_BLOCK), -(-height // METER_BLOCK))
-        self.meter = ctx.texture(meter_size, 1, dtype="f4")
+        self.meter = ctx.texture(meter_size, 2, dtype="f4")
         self.meter_fbo = ctx.framebuffer([self.meter])
         self.sun_depth = ctx.depth_texture((SUN_SHADOW_TEXELS, SUN_SHADOW_TEXELS))
         self.sun_depth.compare_func = "<="
@@ -565,7 +570,8 @@ class GLRenderer:
         """Auto-exposure: the frame's log-average luminance is metered and exposure makes up for
         part of its difference from a daylit room (a camera keeps a dusk room dimmer than a noon
         one), within the camera's range (so a dark room stays dark instead of turning grey)."""
-        average = math.exp(float(np.frombuffer(self.meter.read(), np.float32).mean()))
+        blocks = np.frombuffer(self.meter.read(), np.float32).reshape(-1, 2)
+        average = math.exp(float(np.average(blocks[:, 0], weights=blocks[:, 1] + 1e-9)))
         adapted = EXPOSURE_REFERENCE * (average / EXPOSURE_REFERENCE) ** EXPOSURE_ADAPTATION
         return float(np.clip(EXPOSURE_KEY / adapted, *EXPOSURE_RANGE))
 
@@ -584,6 +590,11 @@ class GLRenderer:
         self._draw_view(view, view_proj, position)
         ctx.depth_func = "<"
         ctx.disable(ctx.DEPTH_TEST)
+        return self._develop(exposure)
+
+    def _develop(self, exposure: float | None) -> RenderedViews:
+        """The camera's side of a frame already drawn into the HDR target: metering, tone map and
+        read-back; raises RenderError where radiance is not finite (never a silently black frame)."""
         self.hdr.use(0)
         self.meter_fbo.use()
         _uniform(self.meter_program, "u_hdr").value = 0
@@ -594,9 +605,14 @@ class GLRenderer:
         _uniform(self.tonemap_program, "u_exposure").value = self._exposure() if exposure is None else exposure
         self.tonemap_vao.render(vertices=3)
         h, w = self.height, self.width
-        rgb = np.frombuffer(self.ldr_fbo.read(components=3), np.uint8).reshape(h, w, 3)[::-1]
+        rgba = np.frombuffer(self.ldr_fbo.read(components=4), np.uint8).reshape(h, w, 4)[::-1]
         depth = np.frombuffer(self.depth.read(), np.float32).reshape(h, w)[::-1].copy()
         instance = np.frombuffer(self.instance.read(), np.int32).reshape(h, w)[::-1]
+        faulty = rgba[..., 3] < 128
+        if faulty.any():
+            raise RenderError(f"{int(faulty.sum())} pixels of non-finite radiance (instances "
+                              f"{sorted(set(instance[faulty].tolist()))[:8]}) in the frame: a shader fault")
+        rgb = rgba[..., :3]
         background = instance == 0
         depth[background | (depth > self.far)] = np.nan
         return RenderedViews(np.ascontiguousarray(rgb), depth, instance.astype(np.uint16), background)
