@@ -40,6 +40,8 @@ if TYPE_CHECKING:
 KINDS = {"floor": 0, "ceiling": 1, "walls": 2, "object": 3, "door": 4, "window": 5}
 MAX_LIGHTS = 32                       # switched-on lights with a shadow map
 FRAME_LIGHTS = 4                      # lights shading one frame (the nearest)
+MAX_WINDOWS = 16                      # windows lighting one frame (uniform array size)
+FRAME_WINDOWS = 8                     # the nearest windows of the rooms in view light a frame
 FRAME_LIGHT_REACH = 9.0               # m: lights farther from the camera are left out of a frame
 SUN_SHADOW_TEXELS = 2048
 LAMP_TILE = 192                       # texels per cube face of a lamp's shadow map
@@ -53,7 +55,9 @@ ROOM_MAP_RESOLUTION = 0.05            # m per cell of the floor-plan room map
 COVERAGE_BLUR_M = 0.12                # sigma of the floor occlusion blur
 
 SUN_IRRADIANCE = 9.0                  # noon sun on a surface facing it
-SKY_AMBIENT = 0.55                    # sky light of a room with generous windows, by day
+SKY_AMBIENT = 0.12                    # bounced sky light filling a room with generous windows, by day
+WINDOW_RADIANCE = 5.0                 # mean radiance of the outdoors seen through a window, by day
+OUTDOOR_DAY = 8.0                     # the outdoors by day against a room's bounce light
 MIN_OPENNESS = 0.25                   # rooms without windows still get light through their doors
 WINDOW_REACH = 6.0                    # window area x this / floor area = fully open room
 LAMP_POWER = 1.0                      # irradiance of an intensity-1 lamp at 1 m
@@ -66,6 +70,9 @@ EXPOSURE_KEY = 0.2                    # mid-grey target of auto-exposure
 EXPOSURE_REFERENCE = 0.5              # log-average luminance of a daylit room
 EXPOSURE_ADAPTATION = 0.5             # how much of a brightness change exposure undoes (1 = all)
 EXPOSURE_RANGE = (0.08, 5.0)          # a camera's exposure limits: night stays dark
+CENTRE_WEIGHT = 3.0                   # metering weight of the frame's middle against its edges
+CENTRE_SPREAD = 0.25                  # sigma of the centre weight, in frame widths and heights
+METER_HIGHLIGHT = math.log(4.0)       # metering counts a block at most 2 stops above the median
 METER_BLOCK = 16                      # pixels per side averaged by one metering texel
 
 
@@ -83,6 +90,7 @@ def _header(pattern: int = -1) -> str:
     defines.append(f"#define PATTERN_ID {pattern}")
     defines += [f"#define KIND_{name.upper()} {i}" for name, i in KINDS.items()]
     defines.append(f"#define MAX_LIGHTS {MAX_LIGHTS}")
+    defines.append(f"#define MAX_WINDOWS {MAX_WINDOWS}")
     return "#version 430\n" + "\n".join(defines) + "\n" + _source("common.glsl") + "\n"
 
 
@@ -152,6 +160,9 @@ class GLRenderer:
         meter_size = (-(-width // METER_BLOCK), -(-height // METER_BLOCK))
         self.meter = ctx.texture(meter_size, 2, dtype="f4")
         self.meter_fbo = ctx.framebuffer([self.meter])
+        rows, cols = np.meshgrid((np.arange(meter_size[1]) + 0.5) / meter_size[1] - 0.5,
+                                 (np.arange(meter_size[0]) + 0.5) / meter_size[0] - 0.5, indexing="ij")
+        self._meter_weights = 1.0 + (CENTRE_WEIGHT - 1.0) * np.exp(-(rows ** 2 + cols ** 2) / (2 * CENTRE_SPREAD ** 2))
         self.sun_depth = ctx.depth_texture((SUN_SHADOW_TEXELS, SUN_SHADOW_TEXELS))
         self.sun_depth.compare_func = "<="
         self.sun_depth.filter = (ctx.LINEAR, ctx.LINEAR)
@@ -186,6 +197,7 @@ class GLRenderer:
         self._light_row = {lt.id: row for row, lt in enumerate(world.house.lights)}
         self._bounds = (np.zeros(3), np.ones(3))
         self._sun_matrix = np.eye(4)
+        self._windows = self._window_lights()
 
     def release(self) -> None:
         """Free the GPU objects (the context stays: it belongs to the process)."""
@@ -320,25 +332,31 @@ class GLRenderer:
         return texture
 
     def _room_ambient(self, room, sun: SunLight, lights: list[Light]) -> np.ndarray:
-        """Sky light through the room's windows plus the bounce of its own lamps. Indoors, light
-        has bounced off white ceilings and walls, so it keeps only part of the daylight's colour
-        (the direct sun keeps all of it: a sunset paints patches, not the whole room)."""
+        """Bounced sky light of the room (more where its windows are larger for its floor) plus the
+        bounce of its own lamps: the fill that reaches every surface; the windows' direct light is
+        window_light's in the shader."""
         house = self.world.house
         window_area = sum(w.width * w.height for w in house.windows if w.room == room.id)
         openness = max(MIN_OPENNESS, min(1.0, WINDOW_REACH * window_area / max(room.area, 1.0)))
-        gain = np.asarray(sun.gain) * (1.0 if sun.angle <= 180.0 else MOONLIGHT)
-        level = float(gain.mean())
-        tint = level * (1.0 - AMBIENT_TINT) + gain * AMBIENT_TINT
+        tint = self._indoor_daylight(sun)
         bounce = sum((np.asarray(lt.color) * lt.intensity for lt in lights if lt.room == room.id), np.zeros(3))
         return SKY_AMBIENT * openness * tint + LAMP_POWER * LAMP_BOUNCE * bounce / max(room.area, 4.0) \
             + NIGHT_FLOOR
+
+    @staticmethod
+    def _indoor_daylight(sun: SunLight) -> np.ndarray:
+        """The daylight's (moonlight's) colour and level as it reaches a room: light that bounced
+        off white ceilings and walls keeps only part of the daylight's colour (the direct sun keeps
+        all of it: a sunset paints patches, not the whole room)."""
+        gain = np.asarray(sun.gain) * (1.0 if sun.angle <= 180.0 else MOONLIGHT)
+        return float(gain.mean()) * (1.0 - AMBIENT_TINT) + gain * AMBIENT_TINT
 
     def _set_lighting(self, sun: SunLight, lights: list[Light]) -> None:
         direction = np.asarray(sun.direction)
         elevation = math.degrees(math.asin(max(-1.0, min(1.0, direction[2]))))
         sun_up = min(1.0, max(0.0, elevation / 2.0 + 0.5)) if sun.angle <= 180.0 else MOONLIGHT
         irradiance = SUN_IRRADIANCE * np.asarray(sun.gain) * sun_up
-        outside = 1.0 if sun.angle <= 180.0 else 3 * MOONLIGHT
+        outside = OUTDOOR_DAY if sun.angle <= 180.0 else 3 * MOONLIGHT
         sky = np.asarray(srgb8_to_linear(sun.sky)) * outside
         level = float(np.mean(sun.gain)) * outside
         uniforms = {
@@ -350,6 +368,7 @@ class GLRenderer:
         }
         for name, value in uniforms.items():
             self._set(name, value, also=(self.sky_program,))
+        self._set("u_window_radiance", tuple(WINDOW_RADIANCE * self._indoor_daylight(sun)))
         self._set("u_shadows", int(self.shadows))
         self._lights = lights
 
@@ -381,9 +400,36 @@ class GLRenderer:
             powers[i] = (*(np.asarray(lt.color) * lt.intensity * LAMP_POWER), row if self.shadows else -1)
             reach[i] = sum(1 << index[room] for room in self._lit_rooms(lt.room))
         self._set("u_light_count", len(chosen))
+        centres, normals, rooms = self._windows
+        near_windows = [i for i in np.argsort(np.linalg.norm(centres[:, :3] - position, axis=1), kind="stable")
+                        if rooms[i] in around][:FRAME_WINDOWS]
+        window_centres = np.zeros((MAX_WINDOWS, 4), np.float32)
+        window_normals = np.zeros((MAX_WINDOWS, 4), np.float32)
+        window_centres[:len(near_windows)] = centres[near_windows]
+        window_normals[:len(near_windows)] = normals[near_windows]
+        self._set("u_window_count", len(near_windows))
+        self._set("u_window_centre", window_centres.tobytes())
+        self._set("u_window_normal", window_normals.tobytes())
         self._set("u_light_position", positions.tobytes())
         self._set("u_light_power", powers.tobytes())
         self._set("u_light_rooms", reach.tobytes())
+
+    def _window_lights(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
+        """Every window as an area light: (centre, room index), (normal into its room, area), room id."""
+        house = self.world.house
+        index = {room.id: i for i, room in enumerate(house.rooms)}
+        centres = np.zeros((len(house.windows), 4), np.float32)
+        normals = np.zeros((len(house.windows), 4), np.float32)
+        for i, w in enumerate(house.windows):
+            room = house.room(w.room)
+            at, normal = np.asarray(w.position[:2]), np.array([-math.sin(w.yaw), math.cos(w.yaw)])
+            if room.contains(*(at + 0.3 * normal)) == room.contains(*(at - 0.3 * normal)):   # the outline misses it
+                normal *= np.sign(normal @ (np.asarray(polygon_centroid(room.floor)) - at)) or 1.0
+            elif not room.contains(*(at + 0.3 * normal)):
+                normal = -normal
+            centres[i] = (*w.position, index[w.room])
+            normals[i] = (*normal, 0.0, w.width * w.height)
+        return centres, normals, [w.room for w in house.windows]
 
     def _lit_rooms(self, room: str) -> set[str]:
         """The rooms a light in ``room`` can reach: its own and (with shadows, which keep the light
@@ -567,11 +613,15 @@ class GLRenderer:
         _uniform(self.sky_program, "u_inverse_view_proj").write(_mat(np.linalg.inv(view_proj)))
         self.empty_vao.render(vertices=3)
     def _exposure(self) -> float:
-        """Auto-exposure: the frame's log-average luminance is metered and exposure makes up for
-        part of its difference from a daylit room (a camera keeps a dusk room dimmer than a noon
-        one), within the camera's range (so a dark room stays dark instead of turning grey)."""
-        blocks = np.frombuffer(self.meter.read(), np.float32).reshape(-1, 2)
-        average = math.exp(float(np.average(blocks[:, 0], weights=blocks[:, 1] + 1e-9)))
+        """Auto-exposure as a camera's centre-weighted metering: the log luminance of the frame,
+        the middle weighted CENTRE_WEIGHT times the edges, is brought part of the way to mid-grey
+        (a camera keeps a dusk room dimmer than a noon one), within the camera's range (so a dark
+        room stays dark instead of turning grey). Highlights count at most METER_HIGHLIGHT above
+        the median, so a bright window clips to white while the room is exposed for, as in a photo."""
+        blocks = np.frombuffer(self.meter.read(), np.float32).reshape(self._meter_weights.shape + (2,))
+        weights = blocks[..., 1] * self._meter_weights + 1e-9
+        log_luminance = np.minimum(blocks[..., 0], np.median(blocks[..., 0]) + METER_HIGHLIGHT)
+        average = math.exp(float(np.average(log_luminance, weights=weights)))
         adapted = EXPOSURE_REFERENCE * (average / EXPOSURE_REFERENCE) ** EXPOSURE_ADAPTATION
         return float(np.clip(EXPOSURE_KEY / adapted, *EXPOSURE_RANGE))
 

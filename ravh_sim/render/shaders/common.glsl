@@ -74,6 +74,28 @@ vec3 outdoor(vec3 d) {
     return mix(ground, u_sky_horizon * 0.7, haze * 0.35);
 }
 
+// Daylight through the windows of a surface's room: each window an area light of the outdoors'
+// mean radiance, its irradiance the on-axis disc form factor A cos_w cos_n / (d^2 + A / pi), so
+// light falls off away from the windows and surfaces turned to them are brighter than those
+// turned away (form shading). Windows of other rooms are walled off.
+uniform int u_window_count;
+uniform vec4 u_window_centre[MAX_WINDOWS];    // xyz, room index
+uniform vec4 u_window_normal[MAX_WINDOWS];    // unit normal into the room, area in m^2
+uniform vec3 u_window_radiance;
+
+vec3 window_light(vec3 p, vec3 n, int room) {
+    float irradiance = 0.0;
+    for (int i = 0; i < u_window_count; ++i) {
+        vec3 d = u_window_centre[i].xyz - p;
+        float d2 = max(dot(d, d), 1e-4);
+        vec3 l = d * inversesqrt(d2);
+        float here = abs(u_window_centre[i].w - float(room)) < 0.5 ? 1.0 : 0.0;
+        float area = u_window_normal[i].w;
+        irradiance += here * max(dot(n, l), 0.0) * max(-dot(u_window_normal[i].xyz, l), 0.0) * area / (d2 + area / PI);
+    }
+    return u_window_radiance * irradiance;
+}
+
 float luminance(vec3 c) {
     return dot(c, vec3(0.2126, 0.7152, 0.0722));
 }

@@ -321,6 +321,7 @@ void main() {
         }
 #endif
         colour = ambient * occlusion * diffuse_albedo + env_f * environment * (1.0 - 0.7 * s.roughness) * occlusion;
+        colour += window_light(v_world + geometric * 0.02, n, room) * diffuse_albedo * (occlusion / PI);
 #if PATTERN_ID == PATTERN_MIRROR
         colour = environment * vec3(0.86, 0.9, 0.9);
 #endif
