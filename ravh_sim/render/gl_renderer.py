@@ -40,8 +40,8 @@ if TYPE_CHECKING:
 KINDS = {"floor": 0, "ceiling": 1, "walls": 2, "object": 3, "door": 4, "window": 5}
 MAX_LIGHTS = 32                       # switched-on lights with a shadow map
 FRAME_LIGHTS = 4                      # lights shading one frame (the nearest)
-MAX_WINDOWS = 16                      # windows lighting one frame (uniform array size)
-FRAME_WINDOWS = 8                     # the nearest windows of the rooms in view light a frame
+MAX_WINDOWS = 32                      # windows of a house (the 30 houses have at most 14)
+WINDOW_SPAN = 64                      # a room's windows: first + WINDOW_SPAN * count (scene.frag)
 FRAME_LIGHT_REACH = 9.0               # m: lights farther from the camera are left out of a frame
 SUN_SHADOW_TEXELS = 2048
 LAMP_TILE = 192                       # texels per cube face of a lamp's shadow map
@@ -55,7 +55,7 @@ ROOM_MAP_RESOLUTION = 0.05            # m per cell of the floor-plan room map
 COVERAGE_BLUR_M = 0.12                # sigma of the floor occlusion blur
 
 SUN_IRRADIANCE = 9.0                  # noon sun on a surface facing it
-SKY_AMBIENT = 0.12                    # bounced sky light filling a room with generous windows, by day
+SKY_AMBIENT = 0.18                    # bounced sky light filling a room with generous windows, by day
 WINDOW_RADIANCE = 5.0                 # mean radiance of the outdoors seen through a window, by day
 OUTDOOR_DAY = 8.0                     # the outdoors by day against a room's bounce light
 MIN_OPENNESS = 0.25                   # rooms without windows still get light through their doors
@@ -66,9 +66,10 @@ LAMP_BOUNCE = 0.35                    # share of a lamp's power that comes back 
 FIXTURE_GLOW = 6.0                    # radiance of a switched-on lamp shade or bulb
 MOONLIGHT = 0.12                      # the moon and night sky, as a share of sun_light's night gain
 NIGHT_FLOOR = 0.002                  # ambient that never goes away (moon, street lights)
-EXPOSURE_KEY = 0.2                    # mid-grey target of auto-exposure
+EXPOSURE_KEY = 0.27                   # mid-grey target of auto-exposure
 EXPOSURE_REFERENCE = 0.5              # log-average luminance of a daylit room
-EXPOSURE_ADAPTATION = 0.5             # how much of a brightness change exposure undoes (1 = all)
+EXPOSURE_ADAPTATION = 0.35            # how much of a dimming exposure undoes (1 = all): dusk stays dim
+EXPOSURE_BRIGHT_ADAPTATION = 0.7      # how much of a brightening beyond a daylit room it undoes
 EXPOSURE_RANGE = (0.08, 5.0)          # a camera's exposure limits: night stays dark
 CENTRE_WEIGHT = 3.0                   # metering weight of the frame's middle against its edges
 CENTRE_SPREAD = 0.25                  # sigma of the centre weight, in frame widths and heights
@@ -91,6 +92,7 @@ def _header(pattern: int = -1) -> str:
     defines += [f"#define KIND_{name.upper()} {i}" for name, i in KINDS.items()]
     defines.append(f"#define MAX_LIGHTS {MAX_LIGHTS}")
     defines.append(f"#define MAX_WINDOWS {MAX_WINDOWS}")
+    defines.append(f"#define WINDOW_SPAN {WINDOW_SPAN}")
     return "#version 430\n" + "\n".join(defines) + "\n" + _source("common.glsl") + "\n"
 
 
@@ -305,7 +307,7 @@ class GLRenderer:
 
     def _upload_instances(self, sun: SunLight, lights: list[Light]) -> None:
         """Per instance: its room, a fixture's glow and the kind, the room's floor and ceiling
-        heights; per room: its sky and bounce light."""
+        heights; per room: its sky and bounce light, and which windows are its own."""
         house, world = self.world.house, self.world
         rooms = {room.id: i for i, room in enumerate(house.rooms)}
         glow = {lt.id: np.asarray(lt.color) * FIXTURE_GLOW * max(lt.intensity, 0.3) for lt in lights}
@@ -316,7 +318,11 @@ class GLRenderer:
             data[0, inst.id, 3] = rooms[inst.room]
             data[1, inst.id] = (*glow.get(inst.name, (0.0, 0.0, 0.0)), KINDS[inst.kind])
             data[2, inst.id, :2] = (room.floor_z, room.ceiling_z)
-        ambient = np.array([[*self._room_ambient(room, sun, lights), 0.0] for room in house.rooms], np.float32)
+        spans = self._windows[2]
+        ambient = np.zeros((len(house.rooms), 4), np.float32)
+        for row, room in enumerate(house.rooms):
+            first, count = spans.get(room.id, (0, 0))
+            ambient[row] = (*self._room_ambient(room, sun, lights), first + WINDOW_SPAN * count)
         self.instance_texture = self._replace(self.instance_texture, self._nearest_texture((size, 3), data))
         self.room_light = self._replace(self.room_light, self._nearest_texture((len(house.rooms), 1), ambient))
 
@@ -369,6 +375,8 @@ class GLRenderer:
         for name, value in uniforms.items():
             self._set(name, value, also=(self.sky_program,))
         self._set("u_window_radiance", tuple(WINDOW_RADIANCE * self._indoor_daylight(sun)))
+        self._set("u_window_centre", self._windows[0].tobytes())
+        self._set("u_window_normal", self._windows[1].tobytes())
         self._set("u_shadows", int(self.shadows))
         self._lights = lights
 
@@ -400,36 +408,32 @@ class GLRenderer:
             powers[i] = (*(np.asarray(lt.color) * lt.intensity * LAMP_POWER), row if self.shadows else -1)
             reach[i] = sum(1 << index[room] for room in self._lit_rooms(lt.room))
         self._set("u_light_count", len(chosen))
-        centres, normals, rooms = self._windows
-        near_windows = [i for i in np.argsort(np.linalg.norm(centres[:, :3] - position, axis=1), kind="stable")
-                        if rooms[i] in around][:FRAME_WINDOWS]
-        window_centres = np.zeros((MAX_WINDOWS, 4), np.float32)
-        window_normals = np.zeros((MAX_WINDOWS, 4), np.float32)
-        window_centres[:len(near_windows)] = centres[near_windows]
-        window_normals[:len(near_windows)] = normals[near_windows]
-        self._set("u_window_count", len(near_windows))
-        self._set("u_window_centre", window_centres.tobytes())
-        self._set("u_window_normal", window_normals.tobytes())
         self._set("u_light_position", positions.tobytes())
         self._set("u_light_power", powers.tobytes())
         self._set("u_light_rooms", reach.tobytes())
 
-    def _window_lights(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
-        """Every window as an area light: (centre, room index), (normal into its room, area), room id."""
+    def _window_lights(self) -> tuple[np.ndarray, np.ndarray, dict[str, tuple[int, int]]]:
+        """Every window as an area light, grouped by room: (centre, 0), (normal into its room, area)
+        and each room's (first, count) in them, so a pixel visits only its own room's windows."""
         house = self.world.house
-        index = {room.id: i for i, room in enumerate(house.rooms)}
-        centres = np.zeros((len(house.windows), 4), np.float32)
-        normals = np.zeros((len(house.windows), 4), np.float32)
-        for i, w in enumerate(house.windows):
+        windows = sorted(house.windows, key=lambda w: [r.id for r in house.rooms].index(w.room))
+        if len(windows) > MAX_WINDOWS:
+            raise ValueError(f"house {house.number} has {len(windows)} windows; the renderer takes {MAX_WINDOWS}")
+        centres = np.zeros((MAX_WINDOWS, 4), np.float32)
+        normals = np.zeros((MAX_WINDOWS, 4), np.float32)
+        spans: dict[str, tuple[int, int]] = {}
+        for i, w in enumerate(windows):
             room = house.room(w.room)
             at, normal = np.asarray(w.position[:2]), np.array([-math.sin(w.yaw), math.cos(w.yaw)])
             if room.contains(*(at + 0.3 * normal)) == room.contains(*(at - 0.3 * normal)):   # the outline misses it
                 normal *= np.sign(normal @ (np.asarray(polygon_centroid(room.floor)) - at)) or 1.0
             elif not room.contains(*(at + 0.3 * normal)):
                 normal = -normal
-            centres[i] = (*w.position, index[w.room])
+            centres[i, :3] = w.position
             normals[i] = (*normal, 0.0, w.width * w.height)
-        return centres, normals, [w.room for w in house.windows]
+            first, count = spans.get(w.room, (i, 0))
+            spans[w.room] = (first, count + 1)
+        return centres, normals, spans
 
     def _lit_rooms(self, room: str) -> set[str]:
         """The rooms a light in ``room`` can reach: its own and (with shadows, which keep the light
@@ -622,7 +626,8 @@ class GLRenderer:
         weights = blocks[..., 1] * self._meter_weights + 1e-9
         log_luminance = np.minimum(blocks[..., 0], np.median(blocks[..., 0]) + METER_HIGHLIGHT)
         average = math.exp(float(np.average(log_luminance, weights=weights)))
-        adapted = EXPOSURE_REFERENCE * (average / EXPOSURE_REFERENCE) ** EXPOSURE_ADAPTATION
+        adaptation = EXPOSURE_ADAPTATION if average < EXPOSURE_REFERENCE else EXPOSURE_BRIGHT_ADAPTATION
+        adapted = EXPOSURE_REFERENCE * (average / EXPOSURE_REFERENCE) ** adaptation
         return float(np.clip(EXPOSURE_KEY / adapted, *EXPOSURE_RANGE))
 
     def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None

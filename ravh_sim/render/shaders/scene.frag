@@ -279,7 +279,8 @@ void main() {
     // to the room in front of them), for its ambient light and for which lamps reach it.
     int room = int(texture(u_room_map, (v_world.xy + geometric.xy * 0.12 - u_room_box.xy) * u_room_box.zw).r + 0.5) - 1;
     if (room < 0) room = int(instance_room.a + 0.5);
-    vec3 ambient = texelFetch(u_room_light, ivec2(room, 0), 0).rgb;
+    vec4 room_light = texelFetch(u_room_light, ivec2(room, 0), 0);   // rgb: bounce light, a: its windows
+    vec3 ambient = room_light.rgb;
     vec3 seeded = v_local + (kind >= KIND_OBJECT ? hash12(vec2(float(v_instance), 1.0)) * 37.0 : 0.0);
     Surface s = pattern(m0.rgb, m2.rgb, m1.x, m1.y, m1.z, m1.w, seeded);
     n = bumped(n, v_world, s.height, m2.a);
@@ -321,7 +322,7 @@ void main() {
         }
 #endif
         colour = ambient * occlusion * diffuse_albedo + env_f * environment * (1.0 - 0.7 * s.roughness) * occlusion;
-        colour += window_light(v_world + geometric * 0.02, n, room) * diffuse_albedo * (occlusion / PI);
+        colour += window_light(v_world + geometric * 0.02, n, room_light.a) * diffuse_albedo * (occlusion / PI);
 #if PATTERN_ID == PATTERN_MIRROR
         colour = environment * vec3(0.86, 0.9, 0.9);
 #endif
