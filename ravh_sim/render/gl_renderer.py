@@ -7,12 +7,15 @@ expensive light transport is computed when the scene changes, not per frame: the
 (orthographic over the house; the ceiling and walls shadow the rooms, so sunlight enters only
 through the window openings), one cube shadow map per switched-on lamp (walls confine its light;
 open doors let it through) and a top-down coverage map that gives floors their ambient occlusion.
-Per frame: the pass, the procedural sky behind the windows, mipmaps for auto-exposure and a tone
-map (ACES, sRGB). ``fast`` quality draws every surface with the plain material in one pass, skips
-shadow look-ups and reflections, and confines lamps to their room instead.
+Per frame: the pass, the procedural sky behind the windows, block metering for auto-exposure and a
+tone map (ACES, sRGB) that refuses non-finite radiance (RenderError) instead of returning a black
+frame. ``fast`` quality draws every surface with the plain material in one pass, skips shadow
+look-ups and reflections, and confines lamps to their room instead.
 
 Light units are arbitrary but consistent (exposure adapts): the sun gives SUN_IRRADIANCE on a
-surface facing it at noon, a lamp of intensity 1 gives LAMP_POWER / d^2.
+surface facing it at noon, a lamp of intensity 1 gives LAMP_POWER / d^2, a window is an area light
+of WINDOW_RADIANCE lighting its own room, and the outdoors seen through it is far brighter than the
+room's walls (OUTDOOR_DAY), so it clips to white as in a photo taken indoors.
 """
 from __future__ import annotations
 
