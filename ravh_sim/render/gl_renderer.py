@@ -7,12 +7,15 @@ expensive light transport is computed when the scene changes, not per frame: the
 (orthographic over the house; the ceiling and walls shadow the rooms, so sunlight enters only
 through the window openings), one cube shadow map per switched-on lamp (walls confine its light;
 open doors let it through) and a top-down coverage map that gives floors their ambient occlusion.
-Per frame: the pass, the procedural sky behind the windows, mipmaps for auto-exposure and a tone
-map (ACES, sRGB). ``fast`` quality draws every surface with the plain material in one pass, skips
-shadow look-ups and reflections, and confines lamps to their room instead.
+Per frame: the pass, the procedural sky behind the windows, block metering for auto-exposure and a
+tone map (ACES, sRGB) that refuses non-finite radiance (RenderError) instead of returning a black
+frame. ``fast`` quality draws every surface with the plain material in one pass, skips shadow
+look-ups and reflections, and confines lamps to their room instead.
 
 Light units are arbitrary but consistent (exposure adapts): the sun gives SUN_IRRADIANCE on a
-surface facing it at noon, a lamp of intensity 1 gives LAMP_POWER / d^2.
+surface facing it at noon, a lamp of intensity 1 gives LAMP_POWER / d^2, a window is an area light
+of WINDOW_RADIANCE lighting its own room, and the outdoors seen through it is far brighter than the
+room's walls (OUTDOOR_DAY), so it clips to white as in a photo taken indoors.
 """
 from __future__ import annotations
 
@@ -40,6 +43,8 @@ if TYPE_CHECKING:
 KINDS = {"floor": 0, "ceiling": 1, "walls": 2, "object": 3, "door": 4, "window": 5}
 MAX_LIGHTS = 32                       # switched-on lights with a shadow map
 FRAME_LIGHTS = 4                      # lights shading one frame (the nearest)
+MAX_WINDOWS = 32                      # windows of a house (the 30 houses have at most 14)
+WINDOW_SPAN = 64                      # a room's windows: first + WINDOW_SPAN * count (scene.frag)
 FRAME_LIGHT_REACH = 9.0               # m: lights farther from the camera are left out of a frame
 SUN_SHADOW_TEXELS = 2048
 LAMP_TILE = 192                       # texels per cube face of a lamp's shadow map
@@ -54,7 +59,9 @@ ROOM_MAP_RESOLUTION = 0.05            # m per cell of the floor-plan room map
 COVERAGE_BLUR_M = 0.12                # sigma of the floor occlusion blur
 
 SUN_IRRADIANCE = 9.0                  # noon sun on a surface facing it
-SKY_AMBIENT = 0.55                    # sky light of a room with generous windows, by day
+SKY_AMBIENT = 0.18                    # bounced sky light filling a room with generous windows, by day
+WINDOW_RADIANCE = 5.0                 # mean radiance of the outdoors seen through a window, by day
+OUTDOOR_DAY = 8.0                     # the outdoors by day against a room's bounce light
 MIN_OPENNESS = 0.25                   # rooms without windows still get light through their doors
 WINDOW_REACH = 6.0                    # window area x this / floor area = fully open room
 LAMP_POWER = 1.0                      # irradiance of an intensity-1 lamp at 1 m
@@ -63,11 +70,20 @@ LAMP_BOUNCE = 0.35                    # share of a lamp's power that comes back 
 FIXTURE_GLOW = 6.0                    # radiance of a switched-on lamp shade or bulb
 MOONLIGHT = 0.12                      # the moon and night sky, as a share of sun_light's night gain
 NIGHT_FLOOR = 0.002                  # ambient that never goes away (moon, street lights)
-EXPOSURE_KEY = 0.2                    # mid-grey target of auto-exposure
+EXPOSURE_KEY = 0.27                   # mid-grey target of auto-exposure
 EXPOSURE_REFERENCE = 0.5              # log-average luminance of a daylit room
-EXPOSURE_ADAPTATION = 0.5             # how much of a brightness change exposure undoes (1 = all)
+EXPOSURE_ADAPTATION = 0.35            # how much of a dimming exposure undoes (1 = all): dusk stays dim
+EXPOSURE_BRIGHT_ADAPTATION = 0.7      # how much of a brightening beyond a daylit room it undoes
 EXPOSURE_RANGE = (0.08, 5.0)          # a camera's exposure limits: night stays dark
+CENTRE_WEIGHT = 3.0                   # metering weight of the frame's middle against its edges
+CENTRE_SPREAD = 0.25                  # sigma of the centre weight, in frame widths and heights
+METER_HIGHLIGHT = math.log(4.0)       # metering counts a block at most 2 stops above the median
 METER_BLOCK = 16                      # pixels per side averaged by one metering texel
+
+
+class RenderError(RuntimeError):
+    """The renderer produced radiance that is not a number: a shader fault. The frame is refused
+    rather than stored, since no exposure makes such pixels right."""
 
 
 def _source(name: str) -> str:
@@ -79,6 +95,8 @@ def _header(pattern: int = -1) -> str:
     defines.append(f"#define PATTERN_ID {pattern}")
     defines += [f"#define KIND_{name.upper()} {i}" for name, i in KINDS.items()]
     defines.append(f"#define MAX_LIGHTS {MAX_LIGHTS}")
+    defines.append(f"#define MAX_WINDOWS {MAX_WINDOWS}")
+    defines.append(f"#define WINDOW_SPAN {WINDOW_SPAN}")
     return "#version 430\n" + "\n".join(defines) + "\n" + _source("common.glsl") + "\n"
 
 
@@ -146,8 +164,11 @@ class GLRenderer:
         self.ldr = ctx.texture(size, 4)
         self.ldr_fbo = ctx.framebuffer([self.ldr])
         meter_size = (-(-width // METER_BLOCK), -(-height // METER_BLOCK))
-        self.meter = ctx.texture(meter_size, 1, dtype="f4")
+        self.meter = ctx.texture(meter_size, 2, dtype="f4")
         self.meter_fbo = ctx.framebuffer([self.meter])
+        rows, cols = np.meshgrid((np.arange(meter_size[1]) + 0.5) / meter_size[1] - 0.5,
+                                 (np.arange(meter_size[0]) + 0.5) / meter_size[0] - 0.5, indexing="ij")
+        self._meter_weights = 1.0 + (CENTRE_WEIGHT - 1.0) * np.exp(-(rows ** 2 + cols ** 2) / (2 * CENTRE_SPREAD ** 2))
         self.sun_depth = ctx.depth_texture((SUN_SHADOW_TEXELS, SUN_SHADOW_TEXELS))
         self.sun_depth.compare_func = "<="
         self.sun_depth.filter = (ctx.LINEAR, ctx.LINEAR)
@@ -185,6 +206,7 @@ class GLRenderer:
         self._light_row = {lt.id: row for row, lt in enumerate(world.house.lights)}
         self._bounds = (np.zeros(3), np.ones(3))
         self._sun_matrix = np.eye(4)
+        self._windows = self._window_lights()
 
     def release(self) -> None:
         """Free the GPU objects (the context stays: it belongs to the process)."""
@@ -314,7 +336,7 @@ class GLRenderer:
 
     def _upload_instances(self, sun: SunLight, lights: list[Light]) -> None:
         """Per instance: its room, a fixture's glow and the kind, the room's floor and ceiling
-        heights; per room: its sky and bounce light."""
+        heights; per room: its sky and bounce light, and which windows are its own."""
         house, world = self.world.house, self.world
         rooms = {room.id: i for i, room in enumerate(house.rooms)}
         glow = {lt.id: np.asarray(lt.color) * FIXTURE_GLOW * max(lt.intensity, 0.3) for lt in lights}
@@ -325,7 +347,11 @@ class GLRenderer:
             data[0, inst.id, 3] = rooms[inst.room]
             data[1, inst.id] = (*glow.get(inst.name, (0.0, 0.0, 0.0)), KINDS[inst.kind])
             data[2, inst.id, :2] = (room.floor_z, room.ceiling_z)
-        ambient = np.array([[*self._room_ambient(room, sun, lights), 0.0] for room in house.rooms], np.float32)
+        spans = self._windows[2]
+        ambient = np.zeros((len(house.rooms), 4), np.float32)
+        for row, room in enumerate(house.rooms):
+            first, count = spans.get(room.id, (0, 0))
+            ambient[row] = (*self._room_ambient(room, sun, lights), first + WINDOW_SPAN * count)
         self.instance_texture = self._replace(self.instance_texture, self._nearest_texture((size, 3), data))
         self.room_light = self._replace(self.room_light, self._nearest_texture((len(house.rooms), 1), ambient))
 
@@ -341,25 +367,31 @@ class GLRenderer:
         return texture
 
     def _room_ambient(self, room, sun: SunLight, lights: list[Light]) -> np.ndarray:
-        """Sky light through the room's windows plus the bounce of its own lamps. Indoors, light
-        has bounced off white ceilings and walls, so it keeps only part of the daylight's colour
-        (the direct sun keeps all of it: a sunset paints patches, not the whole room)."""
+        """Bounced sky light of the room (more where its windows are larger for its floor) plus the
+        bounce of its own lamps: the fill that reaches every surface; the windows' direct light is
+        window_light's in the shader."""
         house = self.world.house
         window_area = sum(w.width * w.height for w in house.windows if w.room == room.id)
         openness = max(MIN_OPENNESS, min(1.0, WINDOW_REACH * window_area / max(room.area, 1.0)))
-        gain = np.asarray(sun.gain) * (1.0 if sun.angle <= 180.0 else MOONLIGHT)
-        level = float(gain.mean())
-        tint = level * (1.0 - AMBIENT_TINT) + gain * AMBIENT_TINT
+        tint = self._indoor_daylight(sun)
         bounce = sum((np.asarray(lt.color) * lt.intensity for lt in lights if lt.room == room.id), np.zeros(3))
         return SKY_AMBIENT * openness * tint + LAMP_POWER * LAMP_BOUNCE * bounce / max(room.area, 4.0) \
             + NIGHT_FLOOR
+
+    @staticmethod
+    def _indoor_daylight(sun: SunLight) -> np.ndarray:
+        """The daylight's (moonlight's) colour and level as it reaches a room: light that bounced
+        off white ceilings and walls keeps only part of the daylight's colour (the direct sun keeps
+        all of it: a sunset paints patches, not the whole room)."""
+        gain = np.asarray(sun.gain) * (1.0 if sun.angle <= 180.0 else MOONLIGHT)
+        return float(gain.mean()) * (1.0 - AMBIENT_TINT) + gain * AMBIENT_TINT
 
     def _set_lighting(self, sun: SunLight, lights: list[Light]) -> None:
         direction = np.asarray(sun.direction)
         elevation = math.degrees(math.asin(max(-1.0, min(1.0, direction[2]))))
         sun_up = min(1.0, max(0.0, elevation / 2.0 + 0.5)) if sun.angle <= 180.0 else MOONLIGHT
         irradiance = SUN_IRRADIANCE * np.asarray(sun.gain) * sun_up
-        outside = 1.0 if sun.angle <= 180.0 else 3 * MOONLIGHT
+        outside = OUTDOOR_DAY if sun.angle <= 180.0 else 3 * MOONLIGHT
         sky = np.asarray(srgb8_to_linear(sun.sky)) * outside
         level = float(np.mean(sun.gain)) * outside
         uniforms = {
@@ -371,6 +403,9 @@ class GLRenderer:
         }
         for name, value in uniforms.items():
             self._set(name, value, also=(self.sky_program,))
+        self._set("u_window_radiance", tuple(WINDOW_RADIANCE * self._indoor_daylight(sun)))
+        self._set("u_window_centre", self._windows[0].tobytes())
+        self._set("u_window_normal", self._windows[1].tobytes())
         self._set("u_shadows", int(self.shadows))
         self._lights = lights
 
@@ -405,6 +440,29 @@ class GLRenderer:
         self._set("u_light_position", positions.tobytes())
         self._set("u_light_power", powers.tobytes())
         self._set("u_light_rooms", reach.tobytes())
+
+    def _window_lights(self) -> tuple[np.ndarray, np.ndarray, dict[str, tuple[int, int]]]:
+        """Every window as an area light, grouped by room: (centre, 0), (normal into its room, area)
+        and each room's (first, count) in them, so a pixel visits only its own room's windows."""
+        house = self.world.house
+        windows = sorted(house.windows, key=lambda w: [r.id for r in house.rooms].index(w.room))
+        if len(windows) > MAX_WINDOWS:
+            raise ValueError(f"house {house.number} has {len(windows)} windows; the renderer takes {MAX_WINDOWS}")
+        centres = np.zeros((MAX_WINDOWS, 4), np.float32)
+        normals = np.zeros((MAX_WINDOWS, 4), np.float32)
+        spans: dict[str, tuple[int, int]] = {}
+        for i, w in enumerate(windows):
+            room = house.room(w.room)
+            at, normal = np.asarray(w.position[:2]), np.array([-math.sin(w.yaw), math.cos(w.yaw)])
+            if room.contains(*(at + 0.3 * normal)) == room.contains(*(at - 0.3 * normal)):   # the outline misses it
+                normal *= np.sign(normal @ (np.asarray(polygon_centroid(room.floor)) - at)) or 1.0
+            elif not room.contains(*(at + 0.3 * normal)):
+                normal = -normal
+            centres[i, :3] = w.position
+            normals[i] = (*normal, 0.0, w.width * w.height)
+            first, count = spans.get(w.room, (i, 0))
+            spans[w.room] = (first, count + 1)
+        return centres, normals, spans
 
     def _lit_rooms(self, room: str) -> set[str]:
         """The rooms a light in ``room`` can reach: its own and (with shadows, which keep the light
@@ -591,11 +649,17 @@ class GLRenderer:
         _uniform(self.sky_program, "u_inverse_view_proj").write(_mat(np.linalg.inv(view_proj)))
         self.empty_vao.render(vertices=3)
     def _exposure(self) -> float:
-        """Auto-exposure: the frame's log-average luminance is metered and exposure makes up for
-        part of its difference from a daylit room (a camera keeps a dusk room dimmer than a noon
-        one), within the camera's range (so a dark room stays dark instead of turning grey)."""
-        average = math.exp(float(np.frombuffer(self.meter.read(), np.float32).mean()))
-        adapted = EXPOSURE_REFERENCE * (average / EXPOSURE_REFERENCE) ** EXPOSURE_ADAPTATION
+        """Auto-exposure as a camera's centre-weighted metering: the log luminance of the frame,
+        the middle weighted CENTRE_WEIGHT times the edges, is brought part of the way to mid-grey
+        (a camera keeps a dusk room dimmer than a noon one), within the camera's range (so a dark
+        room stays dark instead of turning grey). Highlights count at most METER_HIGHLIGHT above
+        the median, so a bright window clips to white while the room is exposed for, as in a photo."""
+        blocks = np.frombuffer(self.meter.read(), np.float32).reshape(self._meter_weights.shape + (2,))
+        weights = blocks[..., 1] * self._meter_weights + 1e-9
+        log_luminance = np.minimum(blocks[..., 0], np.median(blocks[..., 0]) + METER_HIGHLIGHT)
+        average = math.exp(float(np.average(log_luminance, weights=weights)))
+        adaptation = EXPOSURE_ADAPTATION if average < EXPOSURE_REFERENCE else EXPOSURE_BRIGHT_ADAPTATION
+        adapted = EXPOSURE_REFERENCE * (average / EXPOSURE_REFERENCE) ** adaptation
         return float(np.clip(EXPOSURE_KEY / adapted, *EXPOSURE_RANGE))
 
     def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None,
@@ -614,6 +678,11 @@ class GLRenderer:
         self._draw_view(view, view_proj, position)
         ctx.depth_func = "<"
         ctx.disable(ctx.DEPTH_TEST)
+        return self._develop(exposure)
+
+    def _develop(self, exposure: float | None) -> RenderedViews:
+        """The camera's side of a frame already drawn into the HDR target: metering, tone map and
+        read-back; raises RenderError where radiance is not finite (never a silently black frame)."""
         self.hdr.use(0)
         self.meter_fbo.use()
         _uniform(self.meter_program, "u_hdr").value = 0
@@ -624,9 +693,14 @@ class GLRenderer:
         _uniform(self.tonemap_program, "u_exposure").value = self._exposure() if exposure is None else exposure
         self.tonemap_vao.render(vertices=3)
         h, w = self.height, self.width
-        rgb = np.frombuffer(self.ldr_fbo.read(components=3), np.uint8).reshape(h, w, 3)[::-1]
+        rgba = np.frombuffer(self.ldr_fbo.read(components=4), np.uint8).reshape(h, w, 4)[::-1]
         depth = np.frombuffer(self.depth.read(), np.float32).reshape(h, w)[::-1].copy()
         instance = np.frombuffer(self.instance.read(), np.int32).reshape(h, w)[::-1]
+        faulty = rgba[..., 3] < 128
+        if faulty.any():
+            raise RenderError(f"{int(faulty.sum())} pixels of non-finite radiance (instances "
+                              f"{sorted(set(instance[faulty].tolist()))[:8]}) in the frame: a shader fault")
+        rgb = rgba[..., :3]
         background = instance == 0
         depth[background | (depth > self.far)] = np.nan
         linear = None

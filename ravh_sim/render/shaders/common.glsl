@@ -74,6 +74,29 @@ vec3 outdoor(vec3 d) {
     return mix(ground, u_sky_horizon * 0.7, haze * 0.35);
 }
 
+// Daylight through the windows of a surface's room: each window an area light of the outdoors'
+// mean radiance, its irradiance the on-axis disc form factor A cos_w cos_n / (d^2 + A / pi), so
+// light falls off away from the windows and surfaces turned to them are brighter than those
+// turned away (form shading). Windows of other rooms are walled off: ``span`` packs the room's
+// first window and their count (GLRenderer's WINDOW_SPAN), so a pixel visits only its own.
+uniform vec4 u_window_centre[MAX_WINDOWS];    // xyz
+uniform vec4 u_window_normal[MAX_WINDOWS];    // unit normal into the room, area in m^2
+uniform vec3 u_window_radiance;
+
+vec3 window_light(vec3 p, vec3 n, float span) {
+    int code = int(span + 0.5);
+    int first = code % WINDOW_SPAN;
+    float irradiance = 0.0;
+    for (int i = first; i < first + code / WINDOW_SPAN; ++i) {
+        vec3 d = u_window_centre[i].xyz - p;
+        float d2 = max(dot(d, d), 1e-4);
+        vec3 l = d * inversesqrt(d2);
+        float area = u_window_normal[i].w;
+        irradiance += max(dot(n, l), 0.0) * max(-dot(u_window_normal[i].xyz, l), 0.0) * area / (d2 + area / PI);
+    }
+    return u_window_radiance * irradiance;
+}
+
 float luminance(vec3 c) {
     return dot(c, vec3(0.2126, 0.7152, 0.0722));
 }

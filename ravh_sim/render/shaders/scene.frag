@@ -208,7 +208,7 @@ vec3 brdf(vec3 n, vec3 v, vec3 l, vec3 albedo, float roughness, float metalness)
     float k = a * 0.5;
     float visibility = 0.25 / ((n_v * (1.0 - k) + k) * (n_l * (1.0 - k) + k));
     vec3 f0 = mix(vec3(0.04), albedo, metalness);
-    vec3 fresnel = f0 + (1.0 - f0) * pow(1.0 - max(dot(v, h), 0.0), 5.0);
+    vec3 fresnel = f0 + (1.0 - f0) * pow(clamp(1.0 - dot(v, h), 0.0, 1.0), 5.0);
     vec3 diffuse = (1.0 - fresnel) * (1.0 - metalness) * albedo / PI;
     return diffuse + ggx(n_h, a) * visibility * fresnel;
 }
@@ -289,7 +289,8 @@ void main() {
     // to the room in front of them), for its ambient light and for which lamps reach it.
     int room = int(texture(u_room_map, (v_world.xy + geometric.xy * 0.12 - u_room_box.xy) * u_room_box.zw).r + 0.5) - 1;
     if (room < 0) room = int(instance_room.a + 0.5);
-    vec3 ambient = texelFetch(u_room_light, ivec2(room, 0), 0).rgb;
+    vec4 room_light = texelFetch(u_room_light, ivec2(room, 0), 0);   // rgb: bounce light, a: its windows
+    vec3 ambient = room_light.rgb;
     vec3 seeded = v_local + (kind >= KIND_OBJECT ? hash12(vec2(float(v_instance), 1.0)) * 37.0 : 0.0);
     Surface s = pattern(m0.rgb, m2.rgb, m1.x, m1.y, m1.z, m1.w, seeded, layer);
     n = bumped(n, v_world, s.height, m2.a);
@@ -299,7 +300,7 @@ void main() {
     {
         // Window glass: the outdoors through it, the room faintly reflected.
         vec3 through = outdoor(-v);
-        float fresnel = 0.04 + 0.96 * pow(1.0 - max(dot(n, v), 0.0), 5.0);
+        float fresnel = 0.04 + 0.96 * pow(clamp(1.0 - dot(n, v), 0.0, 1.0), 5.0);
         colour = mix(through * vec3(0.92, 0.96, 0.95), ambient * 0.5, fresnel);
     }
 #else
@@ -321,7 +322,9 @@ void main() {
         // dark-below surround of the same colour.
         vec3 r = reflect(-v, n);
         float surround = mix(0.35, 1.4, clamp(r.z * 0.5 + 0.5, 0.0, 1.0));
-        vec3 env_f = f0 + (1.0 - f0) * pow(1.0 - max(dot(n, v), 0.0), 5.0) * (1.0 - s.roughness);
+        // Schlick's Fresnel: two unit vectors can have a dot product a rounding above 1, and
+        // pow of a negative base is NaN on llvmpipe (one such pixel blacked out whole frames).
+        vec3 env_f = f0 + (1.0 - f0) * pow(clamp(1.0 - dot(n, v), 0.0, 1.0), 5.0) * (1.0 - s.roughness);
         vec3 environment = ambient * surround;
 #if GLOSSY
         if (u_probes_ready == 1) {
@@ -329,6 +332,7 @@ void main() {
         }
 #endif
         colour = ambient * occlusion * diffuse_albedo + env_f * environment * (1.0 - 0.7 * s.roughness) * occlusion;
+        colour += window_light(v_world + geometric * 0.02, n, room_light.a) * diffuse_albedo * (occlusion / PI);
 #if PATTERN_ID == PATTERN_MIRROR
         colour = environment * vec3(0.86, 0.9, 0.9);
 #endif

@@ -1,4 +1,5 @@
-// Camera response: the exposure (metered from the frame), ACES filmic curve, sRGB encoding.
+// Camera response: the exposure (metered from the frame), ACES filmic curve, sRGB encoding. Alpha
+// flags pixels whose radiance is not a finite number (0), so a shader fault is never stored silently.
 uniform sampler2D u_hdr;
 uniform float u_exposure;
 out vec4 out_colour;
@@ -8,7 +9,9 @@ vec3 aces(vec3 x) {
 }
 
 void main() {
-    vec3 c = aces(texelFetch(u_hdr, ivec2(gl_FragCoord.xy), 0).rgb * u_exposure);
+    vec3 hdr = texelFetch(u_hdr, ivec2(gl_FragCoord.xy), 0).rgb;
+    bool finite = !any(isnan(hdr)) && !any(isinf(hdr));
+    vec3 c = aces((finite ? hdr : vec3(0.0)) * u_exposure);
     vec3 srgb = mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
-    out_colour = vec4(srgb, 1.0);
+    out_colour = vec4(srgb, finite ? 1.0 : 0.0);
 }
