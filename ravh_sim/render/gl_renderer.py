@@ -678,11 +678,12 @@ class GLRenderer:
         self._draw_view(view, view_proj, position)
         ctx.depth_func = "<"
         ctx.disable(ctx.DEPTH_TEST)
-        return self._develop(exposure)
+        return self._develop(exposure, radiance)
 
-    def _develop(self, exposure: float | None) -> RenderedViews:
+    def _develop(self, exposure: float | None, radiance: bool = False) -> RenderedViews:
         """The camera's side of a frame already drawn into the HDR target: metering, tone map and
-        read-back; raises RenderError where radiance is not finite (never a silently black frame)."""
+        read-back (the HDR target too, for ``radiance``); raises RenderError where radiance is not
+        finite (never a silently black frame)."""
         self.hdr.use(0)
         self.meter_fbo.use()
         _uniform(self.meter_program, "u_hdr").value = 0
@@ -705,6 +706,5 @@ class GLRenderer:
         depth[background | (depth > self.far)] = np.nan
         linear = None
         if radiance:
-            hdr = np.frombuffer(self.hdr.read(), np.float16).reshape(h, w, 4)[::-1, :, :3]
-            linear = np.nan_to_num(hdr.astype(np.float32), nan=0.0, posinf=0.0)
+            linear = np.frombuffer(self.hdr.read(), np.float16).reshape(h, w, 4)[::-1, :, :3].astype(np.float32)
         return RenderedViews(np.ascontiguousarray(rgb), depth, instance.astype(np.uint16), background, linear)
