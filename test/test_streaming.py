@@ -38,7 +38,7 @@ class StandInRenderer:
         self.began: list[float] = []
         self.slow: Callable[[float], bool] = lambda began: True
 
-    def render(self, position, rotation, exposure=None) -> RenderedViews:
+    def render(self, position, rotation, exposure=None, radiance=False) -> RenderedViews:
         began = self.node.runtime.time
         self.began.append(began)
         give_up = time.monotonic() + 60.0
