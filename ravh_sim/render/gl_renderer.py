@@ -20,6 +20,7 @@ room's walls (OUTDOOR_DAY), so it clips to white as in a photo taken indoors.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from importlib import resources
 from typing import TYPE_CHECKING
 
@@ -114,6 +115,50 @@ def _uniform(program: moderngl.Program, name: str) -> moderngl.Uniform:
     return member
 
 
+@dataclass(frozen=True)
+class _Runs:
+    """The vertex buffer as runs of one body's triangles of one pattern (the buffer is sorted by
+    pattern, then body), each with its box in the house frame: what frustum culling draws or skips."""
+    pattern: np.ndarray               # (R,) pattern drawn with
+    first: np.ndarray                 # (R,) first vertex
+    count: np.ndarray                 # (R,) vertices
+    corners: np.ndarray               # (R, 8, 4) homogeneous corners of each run's box
+
+    @staticmethod
+    def of(vertices: np.ndarray, triangle_pattern: np.ndarray, drawn_as: int | None) -> _Runs:
+        """Runs of a pattern-sorted buffer; ``drawn_as`` replaces every pattern (fast quality)."""
+        instance = vertices[::3, 10].astype(np.int64)
+        key = triangle_pattern.astype(np.int64) * (int(instance.max()) + 1) + instance
+        starts = np.concatenate([[0], np.flatnonzero(np.diff(key)) + 1])
+        ends = np.concatenate([starts[1:], [len(key)]])
+        positions = vertices[:, :3].astype(np.float64)
+        lo = np.minimum.reduceat(positions, 3 * starts)
+        hi = np.maximum.reduceat(positions, 3 * starts)
+        pick = np.array([[(i >> axis) & 1 for axis in range(3)] for i in range(8)], bool)
+        corners = np.where(pick[None], hi[:, None, :], lo[:, None, :])
+        corners = np.concatenate([corners, np.ones((*corners.shape[:2], 1))], axis=2)
+        pattern = triangle_pattern[starts] if drawn_as is None else np.full(len(starts), drawn_as)
+        return _Runs(pattern, 3 * starts, 3 * (ends - starts), corners)
+
+    def visible(self, view_proj: np.ndarray) -> np.ndarray:
+        """Runs whose box is not wholly outside one plane of the view frustum."""
+        clip = self.corners @ view_proj.T                                     # (R, 8, 4)
+        w = clip[..., 3]
+        outside = [(clip[..., axis] > w).all(axis=1) | (clip[..., axis] < -w).all(axis=1) for axis in range(3)]
+        return ~(outside[0] | outside[1] | outside[2])
+
+    def spans(self, chosen: np.ndarray) -> list[tuple[int, int]]:
+        """(first vertex, count) of the chosen runs, neighbours in the buffer merged into one draw."""
+        index = np.flatnonzero(chosen)
+        if not len(index):
+            return []
+        first, count = self.first[index], self.count[index]
+        breaks = np.flatnonzero(first[1:] != first[:-1] + count[:-1]) + 1
+        heads = np.concatenate([[0], breaks])
+        tails = np.concatenate([breaks, [len(index)]]) - 1
+        return [(int(first[h]), int(first[t] + count[t] - first[h])) for h, t in zip(heads, tails)]
+
+
 def _mat(m: np.ndarray) -> bytes:
     """A row-major numpy matrix as the column-major bytes GL wants."""
     return np.ascontiguousarray(m.T, dtype=np.float32).tobytes()
@@ -139,7 +184,7 @@ class GLRenderer:
                                for k in range(len(PATTERN))}
         self.depth_program = ctx.program(vertex_shader=header + _source("scene.vert"),
                                          fragment_shader=header + "void main() {}\n")
-        self._ranges: list[tuple[int, int, int]] = []      # (pattern, first vertex, vertex count)
+        self._patterns: list[int] = []                      # the patterns the scene has, a program each
         self._lights: list[Light] = []
         self.sky_program = ctx.program(vertex_shader=header + _source("fullscreen.vert"),
                                        fragment_shader=header + _source("sky.frag"))
@@ -264,10 +309,10 @@ class GLRenderer:
         order = np.argsort(triangle_pattern, kind="stable")
         vertices = vertices.reshape(-1, 3, vertices.shape[1])[order].reshape(vertices.shape)
         counts = np.bincount(triangle_pattern, minlength=len(PATTERN))
-        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
-        self._ranges = [(k, 3 * int(starts[k]), 3 * int(counts[k])) for k in range(len(PATTERN)) if counts[k]]
+        self._patterns = [k for k in range(len(PATTERN)) if counts[k]]
         if not self.shadows:                      # fast: every surface in one plain-material draw
-            self._ranges = [(PATTERN["plain"], 0, len(vertices))]
+            self._patterns = [PATTERN["plain"]]
+        self._runs = _Runs.of(vertices, triangle_pattern[order], PATTERN["plain"] if not self.shadows else None)
         positions = vertices[:, :3]
         self._bounds = (positions.min(axis=0), positions.max(axis=0))
         if self.vbo is not None:
@@ -280,7 +325,7 @@ class GLRenderer:
         self.vbo = self.ctx.buffer(vertices.tobytes())
         self._room_vaos = self._room_subsets(vertices)
         self.vaos = {
-            **{f"scene{k}": self._scene_vao(self.scene_programs[k]) for k, _, _ in self._ranges},
+            **{f"scene{k}": self._scene_vao(self.scene_programs[k]) for k in self._patterns},
             "depth": self.ctx.vertex_array(self.depth_program, [(self.vbo, "3f 40x", "in_position")]),
             "shadow": self.ctx.vertex_array(self.shadow_program, [(self.vbo, SHADOW_FORMAT, "in_position",
                                                                    "in_material")]),
@@ -311,7 +356,6 @@ class GLRenderer:
         count, height, width, _ = layers.shape
         self.library_textures = self.ctx.texture_array((width, height, count), 3, layers.tobytes())
         self.library_textures.build_mipmaps()
-        self.library_textures.anisotropy = 4.0
         self._library_layers = list(self.materials.textures)
 
     def _room_subsets(self, vertices: np.ndarray
@@ -638,13 +682,17 @@ class GLRenderer:
         self._set("u_eye", tuple(float(v) for v in eye))
         ctx.enable(ctx.DEPTH_TEST)
         ctx.disable(ctx.CULL_FACE)
-        # Depth first, then shade only the surviving fragment of each pixel (no overdraw).
+        # Depth first, then shade only the surviving fragment of each pixel (no overdraw); only the
+        # bodies whose boxes meet the view are drawn (a CPU rasteriser pays for every triangle).
+        visible = self._runs.visible(view_proj)
         ctx.depth_func = "<"
         _uniform(self.depth_program, "u_view_proj").write(_mat(view_proj))
-        self.vaos["depth"].render()
+        for first, count in self._runs.spans(visible):
+            self.vaos["depth"].render(first=first, vertices=count)
         ctx.depth_func = "=="
-        for k, first, count in self._ranges:
-            self.vaos[f"scene{k}"].render(first=first, vertices=count)
+        for k in self._patterns:
+            for first, count in self._runs.spans(visible & (self._runs.pattern == k)):
+                self.vaos[f"scene{k}"].render(first=first, vertices=count)
         ctx.depth_func = "<="
         _uniform(self.sky_program, "u_inverse_view_proj").write(_mat(np.linalg.inv(view_proj)))
         self.empty_vao.render(vertices=3)

@@ -32,16 +32,16 @@ import trimesh
 from ravh_sim.errors import UserError
 from ravh_sim.world.library import CATALOG_FORMAT, LibraryMaterial, material_kind, piece_labels
 
-TRIANGLE_BUDGET = 2000
+TRIANGLE_BUDGET = 1000
 """Triangles of a model 1.5 m or larger after simplification (smaller ones get a share in proportion
-to their size, at least MIN_TRIANGLES): a 640x480 frame shows a sofa over ~300 px, where 2k
-triangles already put a triangle on every few silhouette pixels; a house of ~100 objects then stays
-near 150k triangles, whose build (pybullet's triangle-mesh colliders) and GPU upload stay within
-the 2 s house build and the sim's memory budget (measured: 4k per model gave 260k triangles in
-house 23 and 830 MB peak; see the closing note of issue 19)."""
-MIN_TRIANGLES = 300
+to their size, at least MIN_TRIANGLES). A 640x480 frame shows a sofa over ~300 px: 1k triangles keep
+its silhouette and cushions; on llvmpipe every triangle costs in the depth pre-pass and in partly
+covered shading quads, and pybullet builds a collider of each, so house 15 went from 11k triangles
+(procedural) to 52k here (80k with 2k per model: +50 % frame time under load; 130k in house 23 with
+2.5k: 830 MB peak in one process)."""
+MIN_TRIANGLES = 150
 OVER_BUDGET = 1.5
-ABSOLUTE_BUDGET = 3000
+ABSOLUTE_BUDGET = 1500
 """A model that simplification cannot bring within OVER_BUDGET times its budget, nor under
 ABSOLUTE_BUDGET (thousands of loose pieces), is passed over for the kind's next match; a kind whose
 every match is over keeps its smallest."""
