@@ -13,10 +13,11 @@ level of daylight indoors and the sky colour seen beyond the house and through t
 """
 from __future__ import annotations
 
+import contextlib
 import copy
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Any
 
@@ -25,7 +26,7 @@ from ravh_msgs_py.query import UNKNOWN_ID, QueryError
 from ravh_sim.errors import UnknownNameError, UserError
 from ravh_sim.world import paints
 from ravh_sim.world.scene import World
-from ravh_sim.world.settings import Resolved, light_group, load_settings, resolve
+from ravh_sim.world.settings import Resolved, fit_model, light_group, load_settings, resolve
 from ravh_sim.world.solids import model_count
 
 RGB = tuple[float, float, float]
@@ -155,25 +156,68 @@ class Appearance:
 
     # ------------------------------------------------------------------ whole settings
     def apply(self, target: Resolved) -> None:
-        """Bring the world to ``target`` (sun, lights, doors, paint, models), changing only what differs."""
-        self._bring(target.sun_angle, target.lights, target.doors, target.paint, target.models)
+        """Bring the world to ``target`` (sun, lights, doors, paint, models), changing only what differs.
+
+        All or nothing: every item of ``target`` is checked before anything moves, and should a change
+        still fail half-way (pybullet, a full disk under the asset cache) the items already changed are
+        put back, so the world, its state and its footprint are as they were before the call."""
+        self.check(target)
+        before = self.state.settings()
+        try:
+            self._bring(target.sun_angle, target.lights, target.doors, target.paint, target.models)
+        except BaseException:
+            with contextlib.suppress(Exception):      # the first error is the one to report
+                self._bring(before.sun_angle, before.lights, before.doors, before.paint, before.models)
+            raise
+
+    def check(self, target: Resolved) -> None:
+        """Refuse (UserError) a target this world cannot show: an unknown item, a sun angle out of
+        range, an unknown paint, a model index an object does not have. Moves nothing."""
+        house, state = self.house, self.state
+        if not (math.isfinite(target.sun_angle) and 0.0 <= target.sun_angle <= 360.0):
+            raise UserError(f"sun angle must be degrees in [0, 360], got {target.sun_angle!r}")
+        for kind, items, known in (("light", target.lights, state.lights), ("door", target.doors, state.doors),
+                                   ("room", target.paint, state.paint), ("object", target.models, state.models)):
+            for item in items:
+                if item not in known:
+                    raise UnknownNameError(kind, item, list(known))
+        for room_id, surfaces in target.paint.items():
+            for surface, paint in surfaces.items():
+                if surface not in SURFACES:
+                    raise UnknownNameError("surface", surface, list(SURFACES))
+                if not paints.is_paint(paint):
+                    raise UserError(f"{room_id}.{surface}: unknown paint {paint!r}")
+        for object_id, index in target.models.items():
+            count = model_count(house.object(object_id))
+            if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < count:
+                raise UserError(f"{object_id}: model index must be in 0..{count - 1}, got {index!r}")
 
     def randomise(self, seed: int) -> Resolved:
         """Random sun, lights, doors, paint and models (what a settings file of 'random' gives for
         ``seed``); returns the new settings. The noise seed and the agents stay as they were."""
-        target = self._resolve({"lights": {"sun_angle": "random", "ceiling": "random", "lamps": "random"},
-                                "doors": {"all": "random"},
-                                "paint": {"walls": "random", "floors": "random"},
-                                "models": {"all": "random"}}, seed)
-        self.apply(target)
+        self.apply(self.randomised(seed))
         return self.state.settings()
+
+    def randomised(self, seed: int) -> Resolved:
+        """The settings :meth:`randomise` would bring, without changing anything."""
+        return self._resolve({"lights": {"sun_angle": "random", "ceiling": "random", "lamps": "random"},
+                              "doors": {"all": "random"},
+                              "paint": {"walls": "random", "floors": "random"},
+                              "models": {"all": "random"}}, seed)
 
     def change(self, request: dict[str, Any]) -> dict[str, Any]:
         """Apply a parsed appearance request (:func:`ravh_msgs_py.appearance.parse`) and return the
-        reply's result. Names are checked against the house and every choice is resolved like a settings
-        file (same seed rules) before anything changes; only the items the request names change."""
+        reply's result. All or nothing: the whole request is checked against the house and every choice
+        resolved like a settings file (same seed rules) before anything changes (:meth:`apply`); only
+        the items the request names change."""
         if "randomise" in request:
             return {"settings": self.randomise(int(request["randomise"])).to_dict()}
+        self.apply(self.target(request))
+        return {"settings": self.state.settings().to_dict()}
+
+    def target(self, request: dict[str, Any]) -> Resolved:
+        """The settings a parsed appearance request asks for: the current ones with the items it names
+        resolved; changes nothing. Unknown names and impossible values are refused here."""
         self._check_names(request)
         lights, doors, rooms, models = {}, {}, {}, {}
         inherit = {}
@@ -197,21 +241,26 @@ class Appearance:
         picked = self._resolve(overrides, request.get("seed"), "appearance request")
         chosen_models = {o: picked.models[o] for o in models}
         for obj, source in inherit.items():
-            chosen_models[obj] = chosen_models.get(source, self.state.models[source])
-        self._bring(picked.sun_angle if "sun_angle" in request else None,
-                    {lid: picked.lights[lid] for lid in lights}, {d: picked.doors[d] for d in doors},
-                    {r: {s: picked.paint[r][s] for s in surfaces} for r, surfaces in rooms.items()},
-                    chosen_models)
-        return {"settings": self.state.settings().to_dict()}
+            chosen = chosen_models.get(source, self.state.models[source])
+            chosen_models[obj] = fit_model(chosen, self.house.object(obj))
+        now = self.state.settings()
+        target = replace(
+            now, sun_angle=picked.sun_angle if "sun_angle" in request else now.sun_angle,
+            lights={**now.lights, **{lid: picked.lights[lid] for lid in lights}},
+            doors={**now.doors, **{d: picked.doors[d] for d in doors}},
+            paint={r: {**s, **{k: picked.paint[r][k] for k in rooms.get(r, {})}} for r, s in now.paint.items()},
+            models={**now.models, **chosen_models})
+        self.check(target)
+        return target
 
     def _bring(self, sun_angle: float | None, lights: Mapping[str, bool], doors: Mapping[str, bool],
                paint: Mapping[str, Mapping[str, str]], models: Mapping[str, int]) -> None:
         """Change the items given that differ, in the house's order (sun, lights, doors, paint, models)."""
         state = self.state
-        if sun_angle is not None:
+        if sun_angle is not None and sun_angle != state.sun_angle:
             self.set_sun(sun_angle)
         for lid in state.lights:
-            if lid in lights:
+            if lid in lights and lights[lid] != state.lights[lid]:
                 self.set_light(lid, lights[lid])
         for did, is_open in state.doors.items():
             if did in doors and doors[did] != is_open:

@@ -27,7 +27,7 @@ from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
 from ravh_sim.paths import DEFAULT_CONFIG, ROBOTS_DIR
 from ravh_sim.schema import Strict, load_yaml, read_text, shown, validate
 from ravh_sim.world import paints
-from ravh_sim.world.house import House, Light
+from ravh_sim.world.house import House, HouseObject, Light
 from ravh_sim.world.solids import model_count
 
 DOOR_STATES = ("default", *DOOR)          # a settings file may also keep a door as the house has it
@@ -316,7 +316,14 @@ def _resolve_models(cfg: dict, house: House, pick: _Picker, source: str) -> dict
             explicit[obj.id] = pick.rng("model", obj.id).randrange(count)
         else:   # an index: per object it must exist; models.all wraps for objects with fewer models
             explicit[obj.id] = value % count if obj.id not in per_object else _index(value, count, source, key)
-    return {obj.id: _follow(obj.id, explicit, inherit_from) for obj in house.objects}
+    return {obj.id: fit_model(_follow(obj.id, explicit, inherit_from), obj) for obj in house.objects}
+
+
+def fit_model(index: int, obj: HouseObject) -> int:
+    """A model index another object passed on (inheritance), made one that ``obj`` has: a sink
+    inheriting from a counter with more models wraps round, as ``models.all`` does, instead of asking
+    for a model it lacks."""
+    return index % model_count(obj)
 
 
 def _index(value: int, count: int, source: str, key: str) -> int:

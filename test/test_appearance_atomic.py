@@ -1,0 +1,165 @@
+"""Appearance changes are all or nothing, and random choices draw only models each object has
+(issue 24): a request that fails half-way leaves the world, its state and its footprint as they were."""
+from __future__ import annotations
+
+import dataclasses
+import random
+
+import pybullet as pb
+import pytest
+from conftest import resolved
+
+from ravh_msgs_py.appearance import parse
+from ravh_sim.errors import UserError
+from ravh_sim.runtime import SimRuntime
+from ravh_sim.world.appearance import Appearance
+from ravh_sim.world.footprint import make_footprint
+from ravh_sim.world.scene import World
+from ravh_sim.world.settings import load_settings, resolve
+from ravh_sim.world.solids import model_count
+
+REPORTED_SEED = 2602510382          # the issue's seed: Sink_0 inherited Counter_0's model 3, one it lacks
+SINK_MODELS = 2                     # house 15's Sink_0 (checked below); Counter_0 has 4
+SEEDS = [REPORTED_SEED, *random.Random(24).sample(range(2**32), 199)]
+# houses where an object inherits its model from one of a type with more models, and two without
+LINKED_HOUSES = (5, 6, 12, 13, 14, 15, 16, 17, 18, 24)
+APPEARANCE = ("sun_angle", "lights", "doors", "paint", "models")
+RANDOMISE = {"lights": {"sun_angle": "random", "ceiling": "random", "lamps": "random"},
+             "doors": {"all": "random"}, "paint": {"walls": "random", "floors": "random"},
+             "models": {"all": "random"}}
+
+
+@pytest.fixture(scope="module")
+def world(houses):
+    with World(houses[15], resolved(houses[15]), renderer="tiny") as w:
+        yield w
+
+
+@pytest.fixture()
+def appearance(world):
+    app = Appearance(world)
+    yield app
+    app.apply(resolved(world.house))
+
+
+def full_state(world: World) -> dict:
+    """Everything a change could touch: the state and its revisions, the footprint, and per instance
+    its pybullet pose, collision and visual shapes, what the renderer draws (mesh, paint)."""
+    c = world.client
+    bodies = {}
+    for inst in world.instances:
+        visual = world.visuals[inst.body]
+        bodies[inst.name] = (
+            pb.getBasePositionAndOrientation(inst.body, physicsClientId=c),
+            pb.getCollisionShapeData(inst.body, -1, physicsClientId=c),
+            tuple(v[:8] for v in pb.getVisualShapeData(inst.body, physicsClientId=c)),
+            visual.paint, visual.surface, None if visual.mesh is None else visual.mesh.triangle_count)
+    return {"settings": world.state.settings(), "revisions": (world.state.revision, world.state.layout_revision),
+            "footprint": make_footprint(world.house, world.state.settings()), "bodies": bodies,
+            "body_count": pb.getNumBodies(physicsClientId=c)}
+
+
+def _without_revisions(state: dict) -> dict:
+    return {k: v for k, v in state.items() if k != "revisions"}
+
+
+def _everything_request() -> dict:
+    """Sun, lights, doors, paint and three models, then an object asked for a model it lacks (the last
+    item in the order changes are made, so a half-way failure would have moved all the rest)."""
+    return parse({"sun_angle": "night", "lights": {"all": "on"}, "doors": {"all": "closed"},
+                  "paint": {"all": {"walls": "brick", "floor": "marble"}},
+                  "models": {"Bed_0": 1, "Counter_0": 2, "Sink_0": SINK_MODELS}})
+
+
+def test_a_target_that_fails_half_way_changes_nothing(world, appearance):
+    """Everything changes but the last item in the order changes are made (models), which asks an
+    object for a model it lacks: refused before the sun, a light, a door or a paint has moved."""
+    before = full_state(world)
+    renderer_revision = world.revision
+    target = appearance.randomised(7)
+    assert model_count(world.house.object("Sink_0")) == SINK_MODELS
+    target = dataclasses.replace(target, models={**target.models, "Sink_0": SINK_MODELS})
+    with pytest.raises(UserError, match=f"Sink_0: model index must be in 0..{SINK_MODELS - 1}, got {SINK_MODELS}"):
+        appearance.apply(target)
+    assert full_state(world) == before
+    assert world.revision == renderer_revision                 # no body moved, so nothing to redraw
+
+
+def test_a_request_refused_for_its_last_item_changes_nothing(world, appearance):
+    before = full_state(world)
+    with pytest.raises(UserError, match=f"Sink_0.*model index must be in 0..{SINK_MODELS - 1}, got {SINK_MODELS}"):
+        appearance.change(_everything_request())
+    assert full_state(world) == before
+
+
+def test_a_failure_while_moving_puts_everything_back(world, appearance, monkeypatch):
+    """Should a body change itself fail (pybullet, a full disk under the asset cache) after others
+    moved, the items already changed are put back: the state, the footprint and every body as before."""
+    before = full_state(world)
+    load_model, calls = world.load_model, []
+
+    def failing(object_id: str, model: int) -> None:
+        calls.append(object_id)
+        if len(calls) == 2:
+            raise OSError(28, "No space left on device")
+        load_model(object_id, model)
+
+    monkeypatch.setattr(world, "load_model", failing)
+    request = _everything_request()
+    request["models"]["Sink_0"] = 1
+    with pytest.raises(OSError):
+        appearance.change(request)
+    monkeypatch.undo()
+    assert len(calls) >= 2
+    assert _without_revisions(full_state(world)) == _without_revisions(before)
+
+
+def test_the_runtime_replies_no_and_keeps_the_footprint_of_a_failed_request():
+    rt = SimRuntime(15, renderer="tiny")
+    try:
+        footprint = rt.footprint()
+        reply = rt.change_appearance({"sun_angle": "night", "lights": {"all": "on"},
+                                      "paint": {"all": {"walls": "rose"}}, "models": {"Sink_0": 7}})
+        assert not reply["ok"] and "Sink_0" in reply["error"]["message"]
+        assert rt.footprint() == footprint
+        assert rt.change_appearance({"randomise": REPORTED_SEED})["ok"]
+    finally:
+        rt.close()
+
+
+@pytest.mark.parametrize("number", [*LINKED_HOUSES, 20, 23])
+def test_random_settings_draw_only_models_each_object_has(houses, number):
+    """Settings resolution (``ravh footprint N`` with ``models: {all: random}``, randomise) for 200 seeds."""
+    house = houses[number]
+    settings = load_settings()
+    for section, values in RANDOMISE.items():
+        settings[section] = {**settings[section], **values}
+    for seed in SEEDS:
+        models = resolve(settings, house, seed).models
+        for obj in house.objects:
+            assert 0 <= models[obj.id] < model_count(obj), (number, seed, obj.id)
+
+
+def test_inherited_models_that_do_not_exist_wrap_round(houses):
+    house = houses[15]
+    settings = load_settings()
+    settings["models"] = {**settings["models"], "all": "random"}
+    models = resolve(settings, house, REPORTED_SEED).models
+    assert models["Counter_0"] == 3 and models["Sink_0"] == 3 % model_count(house.object("Sink_0"))
+
+
+def test_200_seeds_of_randomise_all_succeed(houses):
+    """200 seeds of ``randomise`` applied, spread over four houses with cross-type inheritance links:
+    every one succeeds and leaves the state it reports."""
+    worlds = {n: World(houses[n], resolved(houses[n]), renderer="tiny") for n in (15, 24, 5, 17)}
+    try:
+        for i, seed in enumerate(SEEDS):
+            world = list(worlds.values())[i % len(worlds)]
+            appearance = Appearance(world)
+            result = appearance.change(parse({"randomise": seed}))
+            assert result["settings"] == world.state.settings().to_dict()
+            wanted = appearance.randomised(seed).to_dict()
+            assert {k: result["settings"][k] for k in APPEARANCE} == {k: wanted[k] for k in APPEARANCE}, seed
+    finally:
+        for world in worlds.values():
+            world.close()
