@@ -56,7 +56,7 @@ def full_state(world: World) -> dict:
             visual.paint, visual.surface, None if visual.mesh is None else visual.mesh.triangle_count)
     return {"settings": world.state.settings(), "revisions": (world.state.revision, world.state.layout_revision),
             "footprint": make_footprint(world.house, world.state.settings()), "bodies": bodies,
-            "body_count": pb.getNumBodies(physicsClientId=c)}
+            "drawn": len(world.visuals)}                  # bodies in the house (swapped-out ones are parked)
 
 
 def _without_revisions(state: dict) -> dict:

@@ -89,6 +89,8 @@ class World:
         pb.setTimeStep(1.0 / physics_hz, physicsClientId=self.client)
         self._assets = cache_dir()
         self._textures: dict[str, int] = {}
+        self._models_now: dict[str, int] = {}     # object -> model of its body, once load_model swapped it
+        self._parked: dict[tuple[str, int], tuple] = {}      # (object, model) -> swapped-out body (load_model)
         self.instances: list[Instance] = []
         self._by_name: dict[str, Instance] = {}
         self.triangle_count = 0
@@ -321,11 +323,20 @@ class World:
     def load_model(self, object_id: str, model: int) -> None:
         """Replace an object's body by model variant ``model`` (visual and collision); a door's new
         leaf goes where the state says the door is."""
-        inst = self._by_name[object_id]
-        obj = self.house.object(object_id)
-        pb.removeBody(inst.body, physicsClientId=self.client)
-        del self.visuals[inst.body]
-        inst.body = self._object_body(obj, model)
+        # pybullet frees neither a removed body's memory (~2 kB per hull part) nor its shapes, so the old
+        # body is parked out of the house like an open door's leaf and comes back with its model.
+        inst, c = self._by_name[object_id], self.client
+        position, orientation = pb.getBasePositionAndOrientation(inst.body, physicsClientId=c)
+        pb.resetBasePositionAndOrientation(inst.body, [*position[:2], position[2] - OPEN_DOOR_DROP], orientation,
+                                           physicsClientId=c)
+        old = self._models_now.get(object_id, self.state.models[object_id])
+        self._parked[object_id, old] = (inst.body, self.visuals.pop(inst.body), position, orientation)
+        if (object_id, model) in self._parked:
+            inst.body, self.visuals[inst.body], position, orientation = self._parked.pop((object_id, model))
+            pb.resetBasePositionAndOrientation(inst.body, position, orientation, physicsClientId=c)
+        else:
+            inst.body = self._object_body(self.house.object(object_id), model)
+        self._models_now[object_id] = model
         self.revision += 1
         if inst.kind == "door":
             self.place_door(object_id, self.state.doors[object_id])
