@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 from conftest import ROOT, subprocess_env
 
+import ravh_sim
 from ravh_sim.dataset.api import Dataset
 from ravh_sim.dataset.build import build, parse_numbers, raid_seed, summary_table
 from ravh_sim.errors import UserError
@@ -94,6 +95,57 @@ def test_a_half_written_raid_is_redone_from_an_empty_folder(tmp_path):
     assert not result["failed"] and result["raids"][0]["captures"] == 5
     ds = _complete(stale)
     assert len(ds) == 5 and not (stale / "rgb" / "000099.png").exists()
+
+
+def test_a_resume_redoes_a_raid_recorded_with_other_parameters(tmp_path):
+    """Issue 24: a build with --max-captures 5, then without it, printed '1 already there' and kept 5
+    captures; another --seed kept the old seed's raid. Resume compares what the raid was built with."""
+    folder = tmp_path / "house20" / "raid1"
+    redone: list[tuple[str, str]] = []
+
+    def again(**kwargs) -> dict:
+        redone.clear()
+        return build(tmp_path, [20], [1], show_progress=False, on_redo=lambda *a: redone.append(a), **kwargs)
+
+    first = again(max_captures=5)
+    recorded = json.loads((folder / "raid.json").read_text())["build"]
+    assert recorded == {"seed": 201, "preset": recorded["preset"], "max_captures": 5, "max_nodes": 0,
+                        "engine": "direct", "version": ravh_sim.__version__}
+    assert recorded["preset"]["behaviour"] == "wanderer" and first["raids"][0]["captures"] == 5
+    stamp = (folder / "raid.json").stat().st_mtime_ns
+
+    same = again(max_captures=5)                                 # the same request: kept as it is
+    assert same["skipped"] == 1 and not same["redone"] and not redone
+    assert (folder / "raid.json").stat().st_mtime_ns == stamp
+
+    more = again(max_captures=8)                                 # another limit: redone, and said why
+    assert more["skipped"] == 0 and more["raids"][0]["captures"] == 8 and len(_complete(folder)) == 8
+    assert redone == [("house20/raid1", "max captures 5, asked for 8")] == list(more["redone"].items())
+
+    other_seed = again(max_captures=8, seed=3)
+    assert redone == [("house20/raid1", f"seed 201, asked for {raid_seed(20, 1, 3)}")]
+    assert Dataset(folder).meta["raid"]["build"]["seed"] == raid_seed(20, 1, 3) == other_seed["raids"][0]["seed"]
+
+    summary = json.loads((folder / "raid.json").read_text())   # a raid of an older ravh_sim: no parameters
+    del summary["build"]
+    (folder / "raid.json").write_text(json.dumps(summary))
+    old = again(max_captures=8, seed=3)
+    assert redone == [("house20/raid1", "recorded without its build parameters (an older ravh_sim)")]
+    assert old["raids"][0]["build"]["max_captures"] == 8
+
+
+def test_the_build_command_names_the_parameter_that_differs(tmp_path):
+    args = ("dataset", "build", "--houses", "20", "--raids", "1", "--out", str(tmp_path), "--no-progress")
+    first = _ravh(*args, "--max-captures", "3")
+    stdout, stderr = first.communicate(timeout=300)
+    assert first.returncode == 0, stderr[-3000:]
+    second = _ravh(*args, "--max-captures", "4", "--engine", "direct")
+    stdout, stderr = second.communicate(timeout=300)
+    assert second.returncode == 0, stderr[-3000:]
+    assert "raid house20/raid1 was recorded with other parameters, redoing it: max captures 3, asked for 4" \
+        in stderr
+    assert "(0 already there, 1 redone with other parameters)" in stdout
+    assert len(_complete(tmp_path / "house20" / "raid1")) == 4
 
 
 def test_a_failed_raid_is_named_and_the_exit_status_is_not_zero(tmp_path):

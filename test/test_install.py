@@ -60,3 +60,13 @@ def test_package_xml_declares_every_ros_package_the_code_imports():
                                    re.MULTILINE))
     assert {"tf2_msgs", "diagnostic_msgs", "rclpy"} <= imported
     assert imported <= declared, imported - declared
+
+
+def test_one_version_in_the_package_setup_py_and_package_xml():
+    """A dataset build records ravh_sim.__version__ with every raid (a resume redoes raids of another)."""
+    import re
+
+    import ravh_sim
+    root = Path(__file__).resolve().parents[1]
+    assert f'version="{ravh_sim.__version__}"' in (root / "setup.py").read_text()
+    assert re.search(rf"<version>{re.escape(ravh_sim.__version__)}</version>", (root / "package.xml").read_text())

@@ -5,9 +5,11 @@ Every (house, raid) runs the paper's preset (:data:`ravh_sim.dataset.raid.PRESET
 or the ROS engine (``ravh raid``'s three processes). Raids run on a local process pool, or as Ray
 tasks on a cluster (``--ray ADDRESS``; ``pip install ravh_sim[ray]``) whose nodes share OUT.
 
-The output folder is the only state: a raid whose raid.json says it finished is skipped, any other
-raid folder is an interrupted or failed run and is deleted before the raid runs again, so a build
-can be stopped at any moment and resumed with the same command. Progress counts the lines of the
+The output folder is the only state: a raid whose raid.json says it finished with the parameters
+asked for now (seed, preset, max captures and nodes, engine, ravh_sim version: :func:`parameters`)
+is skipped; one recorded with other parameters is named with what differs and run again, and any
+other raid folder is an interrupted or failed run and is deleted before the raid runs again, so a
+build can be stopped at any moment and resumed with the same command. Progress counts the lines of the
 raids' captures.jsonl, so it covers every worker of a cluster with no messages between them.
 """
 from __future__ import annotations
@@ -27,6 +29,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ravh_sim import __version__
 from ravh_sim.dataset import layout
 from ravh_sim.dataset.raid import PRESETS, preset_settings, run_raid
 from ravh_sim.errors import UserError
@@ -87,6 +90,39 @@ def finished(folder: Path) -> dict[str, Any] | None:
     return summary if status == "done" or status.startswith("stopped at") else None
 
 
+def parameters(job: Job, options: BuildOptions) -> dict[str, Any]:
+    """What a raid of a build is recorded with (raid.json's ``build``): a finished raid is resumed
+    only when these equal the request's. ``max_nodes`` counts for grid raids only."""
+    preset = PRESETS[job.raid]
+    return {"seed": job.seed, "preset": dict(preset.__dict__), "max_captures": options.max_captures,
+            "max_nodes": options.max_nodes if preset.behaviour == "grid" else 0, "engine": options.engine,
+            "version": __version__}
+
+
+PARAMETER_NAMES = {"seed": "seed", "preset": "preset", "max_captures": "max captures", "max_nodes": "max nodes",
+                   "engine": "engine", "version": "ravh_sim version"}
+
+
+def difference(summary: dict[str, Any], wanted: dict[str, Any]) -> str | None:
+    """Why a finished raid is not the one asked for (None: it is), e.g. 'max captures 5, asked for 0'."""
+    recorded = summary.get("build")
+    if not isinstance(recorded, dict):
+        return "recorded without its build parameters (an older ravh_sim)"
+    differ = [f"{PARAMETER_NAMES[key]} {_shown(key, recorded.get(key))}, asked for {_shown(key, value)}"
+              for key, value in wanted.items() if recorded.get(key) != value]
+    return "; ".join(differ) or None
+
+
+def _shown(key: str, value: Any) -> str:
+    if value is None:
+        return "(not recorded)"
+    if key in ("max_captures", "max_nodes") and value == 0:
+        return "0 (no limit)"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} {v}" for k, v in value.items()) + "}"
+    return str(value)
+
+
 def clear_unfinished(folder: Path) -> None:
     """Delete what an interrupted or failed run left, so the raid starts from an empty folder."""
     if folder.exists() and finished(folder) is None:
@@ -98,15 +134,17 @@ def run_job(job: Job, root: Path, options: BuildOptions) -> dict[str, Any]:
     out = root / job.name
     clear_unfinished(out)                    # a retried task finds its own earlier attempt
     preset = PRESETS[job.raid]
+    recorded = {"build": parameters(job, options)}          # in raid.json: what a resume compares
     if options.engine == "ros":
         return run_raid(job.house, job.raid, out, fast=True, seed=job.seed, max_captures=options.max_captures,
-                        max_nodes=options.max_nodes, quiet=True)
+                        max_nodes=options.max_nodes, quiet=True, meta=recorded)
     (out / "logs").mkdir(parents=True)
     with _output_to(out / "logs" / "direct.log"):
         from ravh_sim.dataset.direct import GridSpec, WandererSpec, record
         spec = GridSpec(max_nodes=options.max_nodes) if preset.behaviour == "grid" else WandererSpec()
         return record(out, job.house, spec, settings=preset_settings(preset, job.seed), seed=job.seed,
-                      max_captures=options.max_captures, raid={"raid": job.raid, "preset": preset.__dict__})
+                      max_captures=options.max_captures,
+                      raid={"raid": job.raid, "preset": preset.__dict__, **recorded})
 
 
 @contextlib.contextmanager
@@ -130,20 +168,36 @@ def _output_to(log: Path) -> Iterator[None]:
 
 def build(root: Path, houses: list[int], raids: list[int], workers: int = 1, engine: str = "direct",
           seed: int | None = None, ray_address: str | None = None, max_captures: int = 0,
-          max_nodes: int = 0, show_progress: bool = True) -> dict[str, Any]:
-    """Run every (house, raid) not yet finished under ``root``; returns every raid's summary and
-    the names of those that failed."""
+          max_nodes: int = 0, show_progress: bool = True,
+          on_redo: Callable[[str, str], None] | None = None) -> dict[str, Any]:
+    """Run every (house, raid) not yet finished under ``root`` with these parameters; returns every
+    raid's summary, the names of those that failed and of those redone because they had been
+    recorded with other parameters (each also passed to ``on_redo(name, why)`` before anything runs)."""
     if engine not in ENGINES:
         raise UserError(f"--engine: unknown engine {engine!r}; valid: {', '.join(ENGINES)}")
     if workers < 1:
         raise UserError(f"--workers must be >= 1, got {workers}")
     root.mkdir(parents=True, exist_ok=True)
     jobs = [Job(h, r, raid_seed(h, r, seed)) for h in houses for r in raids]
-    done = {job: s for job in jobs if (s := finished(root / job.name)) is not None}
+    options = BuildOptions(engine, max_captures, max_nodes)
+    done: dict[Job, dict[str, Any]] = {}
+    redone: dict[str, str] = {}
+    for job in jobs:
+        summary = finished(root / job.name)
+        if summary is None:
+            continue
+        why = difference(summary, parameters(job, options))
+        if why is None:
+            done[job] = summary
+        else:
+            redone[job.name] = why
+            if on_redo is not None:
+                on_redo(job.name, why)
     todo = [job for job in jobs if job not in done]
     for job in todo:
+        if job.name in redone:
+            shutil.rmtree(root / job.name)
         clear_unfinished(root / job.name)
-    options = BuildOptions(engine, max_captures, max_nodes)
     progress = Progress(root, todo, show_progress)
     failed: dict[str, str] = {}
 
@@ -161,7 +215,7 @@ def build(root: Path, houses: list[int], raids: list[int], workers: int = 1, eng
     finally:
         progress.close()
     summaries = [done[j] for j in jobs if j in done]
-    return {"raids": summaries, "skipped": len(jobs) - len(todo), "failed": failed,
+    return {"raids": summaries, "skipped": len(jobs) - len(todo), "redone": redone, "failed": failed,
             "wall_s": round(time.monotonic() - start, 1)}
 
 
@@ -356,10 +410,15 @@ def cmd_build(args: argparse.Namespace) -> int:
     from ravh_sim.world.house import available_houses
     houses = parse_numbers(args.houses, available_houses(), "houses")
     raids = parse_numbers(args.raids, range(len(PRESETS)), "raids")
+
+    def say_redo(name: str, why: str) -> None:
+        print(f"ravh: raid {name} was recorded with other parameters, redoing it: {why}", file=sys.stderr)
+
     result = build(args.out, houses, raids, args.workers, args.engine, args.seed, args.ray,
-                   args.max_captures, args.max_nodes, args.progress)
+                   args.max_captures, args.max_nodes, args.progress, say_redo)
     print(summary_table(result))
-    print(f"{len(result['raids'])} raids in {args.out} ({result['skipped']} already there), "
+    redone = f", {len(result['redone'])} redone with other parameters" if result["redone"] else ""
+    print(f"{len(result['raids'])} raids in {args.out} ({result['skipped']} already there{redone}), "
           f"{result['wall_s']:.0f} s")
     for name, why in sorted(result["failed"].items()):
         print(f"ravh: raid {name} failed: {why} (see {args.out / name})", file=sys.stderr)

@@ -70,8 +70,10 @@ def preset_settings(preset: RaidPreset, seed: int) -> dict:
 
 
 def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | None = None,
-             max_captures: int = 0, max_nodes: int = 0, timeout: float = 3600.0, quiet: bool = False) -> dict:
-    """Run one raid into the new folder ``out``; returns its summary (also written to ``out/raid.json``)."""
+             max_captures: int = 0, max_nodes: int = 0, timeout: float = 3600.0, quiet: bool = False,
+             meta: dict | None = None) -> dict:
+    """Run one raid into the new folder ``out``; returns its summary (also written to ``out/raid.json``).
+    ``meta``: more keys for dataset.json's ``raid`` and the summary (a build's parameters)."""
     if not 0 <= raid < len(PRESETS):
         raise UserError(f"unknown raid {raid}; valid: {', '.join(map(str, range(len(PRESETS))))}")
     preset = PRESETS[raid]
@@ -93,7 +95,7 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
                       else ["--captures", "10", "--max-nodes", str(max_nodes)])
     start = time.monotonic()
     raid_meta = {"house": house, "raid": raid, "preset": preset.__dict__, "seed": seed, "fast": fast,
-                 "ros_domain_id": domain}
+                 "ros_domain_id": domain, **(meta or {})}
     captures, given = out / layout.CAPTURES_JSONL, logs / "behaviour_captures.jsonl"
     status = "done"
     sim = recorder = behaviour = None
