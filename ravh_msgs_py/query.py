@@ -18,6 +18,7 @@ BAD_REQUEST = "bad_request"
 UNKNOWN_QUERY = "unknown_query"
 UNKNOWN_ID = "unknown_id"
 INTERNAL = "internal"
+BUSY = "busy"              # the sim refused the request to keep its rate (a burst): send it again later
 
 # Requests are small; anything longer is refused before decoding, and no reply quotes more than a few
 # hundred characters of what it was sent (a 10 MB request must not come back or stay in memory).

@@ -35,6 +35,12 @@ HANDOVER_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=Reliabilit
 # matched only after the first capture still gets its confirmation (a behaviour holds one at a time)
 RECORDED_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100, reliability=ReliabilityPolicy.RELIABLE,
                           durability=DurabilityPolicy.TRANSIENT_LOCAL)
+# service requests waiting while the node steps: rclpy's default keeps 10 and silently drops older ones
+# under a burst (the client then waits for a reply that never comes); the JSON services also answer
+# every queued request in one go (SimNode), refusing with "busy" what they cannot do now
+SERVICE_QUEUE = 256
+SERVICE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=SERVICE_QUEUE,
+                         reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE)
 COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.VOLATILE)
 

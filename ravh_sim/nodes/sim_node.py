@@ -31,6 +31,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import threading
 import time
 from collections import deque
 from collections.abc import Callable
@@ -52,7 +53,7 @@ from tf2_msgs.msg import TFMessage
 
 from ravh_msgs_py import names as n
 from ravh_msgs_py.capture import CaptureEvent
-from ravh_msgs_py.query import MAX_REQUEST_CHARS
+from ravh_msgs_py.query import BUSY, MAX_REQUEST_CHARS, error_reply
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nodes import convert
@@ -61,6 +62,8 @@ from ravh_sim.nodes.common import (
     HANDOVER_QOS,
     LATCHED_QOS,
     SENSOR_QOS,
+    SERVICE_QOS,
+    SERVICE_QUEUE,
     STATE_QOS,
     return_freed_memory,
     run_node,
@@ -90,6 +93,14 @@ PARAMETERS: dict[str, Any] = {
     "cmd_vel_stamped": False, "map_tf": "auto", "lockstep": False, "frame_policy": "drop",
 }
 HEARTBEAT_S = 0.5                       # lockstep: wall period of /clock and pose while waiting
+# Appearance changes under a burst. A change costs its own work and more at the next readings (a light-map
+# redo of ~0.1-0.7 s at the next camera frame, a new /map): the node measures that and lets changes take at
+# most CHANGE_SHARE of its wall time (CHANGE_BURST_S at once), and of requests that wait together it makes
+# at most CHANGES_PER_BATCH. The rest get a "busy" reply at once: every request is answered and /clock
+# keeps its rate.
+CHANGE_SHARE = 0.15
+CHANGE_BURST_S = 1.0
+CHANGES_PER_BATCH = 1
 
 
 class SimNode(Node):
@@ -135,6 +146,9 @@ class SimNode(Node):
         self._wall0, self._sim0 = time.monotonic(), rt.time
         self._next_clock = 0.0
         self._clock_sent = -math.inf
+        self._changes_in_batch = 0
+        self._change_budget = WorkBudget(CHANGE_BURST_S, CHANGE_SHARE)
+        self._charged: set[tuple[str, str]] = set()      # (agent, port): next reading's time is a change's
         self._own_map_odom: deque[tuple] = deque(maxlen=256)      # what this node put on /tf lately
         self._foreign_map_odom: dict[str, float] = {}              # odom frame -> wall time last seen
         self._publishing_map_tf = {agent.name: self.map_tf != "off" for agent in rt.agents}
@@ -189,8 +203,8 @@ class SimNode(Node):
 
     def _make_services(self) -> None:
         srv = self.create_service
-        srv(AddDiagnostics, n.QUERY_SERVICE, self._on_query)
-        srv(AddDiagnostics, n.APPEARANCE_SERVICE, self._on_appearance)
+        self._json_service(n.QUERY_SERVICE, self._on_query)
+        self._json_service(n.APPEARANCE_SERVICE, self._on_appearance)
         srv(GetMap, n.GET_MAP_SERVICE, lambda req, res: self._on_get_map(res, self.runtime.navigation.obstacle_map))
         srv(GetMap, n.GET_FREE_SPACE_SERVICE, lambda req, res: self._on_get_map(res, self.runtime.navigation.map))
         srv(GetPlan, n.GET_PLAN_SERVICE, self._on_get_plan)
@@ -198,6 +212,35 @@ class SimNode(Node):
         for agent in self.runtime.agents:
             srv(Trigger, n.agent_name(n.CAPTURE_SERVICE, agent.name, agent.first),
                 lambda req, res, a=agent: self._on_capture(a, res))
+
+    def _json_service(self, name: str, handler: Callable) -> None:
+        """A JSON service that answers every request waiting for it: the executor takes one request
+        per service per wait, so a burst faster than the node's ticks would pile up in the queue."""
+        def callback(request: AddDiagnostics.Request, response: AddDiagnostics.Response):
+            self._changes_in_batch = 0
+            response = handler(request, response)
+            self._answer_waiting(service, handler)
+            return response
+        service = self.create_service(AddDiagnostics, name, callback, qos_profile=SERVICE_QOS)
+
+    @staticmethod
+    def _answer_waiting(service: Any, handler: Callable) -> None:
+        for _ in range(SERVICE_QUEUE):
+            with service.handle:
+                request, header = service.handle.service_take_request(AddDiagnostics.Request)
+            if header is None:
+                return
+            service.send_response(handler(request, AddDiagnostics.Response()), header)
+
+    def _busy(self) -> str | None:
+        """Why an appearance change must wait (None: it can be made now)."""
+        if self._changes_in_batch >= CHANGES_PER_BATCH:
+            return "the sim is busy: requests came faster than it steps; send this one again in a moment"
+        wait = self._change_budget.wait_s()
+        if wait > 0:
+            return (f"the sim is busy with earlier appearance changes (they may take {CHANGE_SHARE:.0%} of its "
+                    f"time); send this one again in {wait:.1f} s")
+        return None
 
     # ------------------------------------------------------------------ stepping
     def _tick(self) -> None:
@@ -248,7 +291,9 @@ class SimNode(Node):
             self._now()
             self._next_clock += self.clock_period
         if rt.map_version != self._published_map:
-            self._publish_map()
+            start = time.monotonic()
+            self._publish_map()                  # a door or a model changed: the change's cost
+            self._change_budget.spend(time.monotonic() - start)
         for agent in rt.agents:
             if rt.due(agent, ODOM):
                 self._publish_state(agent)
@@ -340,7 +385,9 @@ class SimNode(Node):
             rt.skip(agent, port.name)
             return
         if port.name != CAMERA:
+            start = time.monotonic()
             self._publish_sensor(agent, port, rt.read(agent, port.name), self._now(), topics)
+            self._note_reading((agent.name, port.name), time.monotonic() - start)
             return
         busy = self._frames.get(agent.name)
         if busy is not None and not busy.done() and self.frame_policy == "drop":
@@ -361,7 +408,9 @@ class SimNode(Node):
                       topics: tuple[Topic, ...]) -> None:
         """On the render thread: render ``frame`` and publish it on ``topics``, stamped ``stamp`` (when it
         was asked for: the sim time of its pose)."""
+        start = time.monotonic()
         self._publish_sensor(agent, port, frame(), stamp, topics)
+        self._note_reading((agent.name, port.name), time.monotonic() - start)
 
     def _publish_sensor(self, agent: Agent, port: SensorPort, data: Any, stamp: float,
                         topics: tuple[Topic, ...]) -> None:
@@ -371,6 +420,14 @@ class SimNode(Node):
         for topic in topics:
             value = topic.value(data, agent.sensors[port.name], frame)
             pubs[topic.key].publish(convert.KINDS[topic.kind].to_message(value, hdr))
+
+    def _note_reading(self, key: tuple[str, str], seconds: float) -> None:
+        """Charge the whole first reading of each sensor after an appearance change to the change (the
+        renderer redoing its light maps). Only the excess is the change's, but under load every frame
+        slows and the excess over a usual time measured then was too little: the charge errs high."""
+        if key in self._charged:             # (the camera's frames are noted on the render thread)
+            self._charged.discard(key)
+            self._change_budget.spend(seconds)
 
     def _publish_capture(self, agent: Agent) -> CaptureEvent:
         """A requested capture: every sensor of the agent at one stamp on every topic, subscribed or
@@ -431,12 +488,20 @@ class SimNode(Node):
         return response
 
     def _on_appearance(self, request: AddDiagnostics.Request, response: AddDiagnostics.Response):
-        # on the render thread: a renderer reads the world's appearance while it renders
-        reply = self._on_render_thread(self.runtime.change_appearance, request.load_namespace)
+        busy = self._busy()
+        if busy is not None:
+            reply = error_reply(BUSY, busy)
+        else:
+            start = time.monotonic()
+            # on the render thread: a renderer reads the world's appearance while it renders
+            reply = self._on_render_thread(self.runtime.change_appearance, request.load_namespace)
+            if reply["ok"]:
+                self._changes_in_batch += 1
+                self._publish_footprint()            # /map follows on the next step if doors changed
+                self._charged = {(agent.name, port.name) for agent in self.runtime.agents for port in SENSORS}
+                self._change_budget.spend(time.monotonic() - start)
         response.success, response.message = bool(reply["ok"]), json.dumps(reply)
         _forget_if_oversized(request)
-        if reply["ok"]:
-            self._publish_footprint()            # /map follows on the next step if doors changed
         return response
 
     def _on_get_map(self, response: GetMap.Response, grid: Callable[[], Grid]):
@@ -484,6 +549,31 @@ class SimNode(Node):
     def close(self) -> None:
         self._on_render_thread(self.runtime.close)
         self.render_thread.shutdown()
+
+
+class WorkBudget:
+    """Wall time some work may take from a loop: ``burst`` seconds at once, refilled at ``share`` seconds
+    per second (a token bucket counted in seconds)."""
+
+    def __init__(self, burst: float, share: float) -> None:
+        self.burst, self.share = burst, share
+        self.level, self._at = burst, time.monotonic()
+        self._lock = threading.Lock()               # spent from the render thread too
+
+    def _refill(self) -> None:
+        now = time.monotonic()
+        self.level, self._at = min(self.burst, self.level + self.share * (now - self._at)), now
+
+    def spend(self, seconds: float) -> None:
+        with self._lock:
+            self._refill()
+            self.level -= seconds
+
+    def wait_s(self) -> float:
+        """How long until the work may run again (0: now)."""
+        with self._lock:
+            self._refill()
+            return 0.0 if self.level > 0 else -self.level / self.share
 
 
 def _forget_if_oversized(request: AddDiagnostics.Request) -> None:
