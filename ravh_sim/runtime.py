@@ -15,14 +15,16 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ravh_msgs_py import appearance as appearance_lang
 from ravh_msgs_py import names
 from ravh_msgs_py.capture import CaptureEvent
-from ravh_msgs_py.query import BAD_REQUEST, INTERNAL, MAX_COORDINATE, QueryError, error_reply, ok_reply
+from ravh_msgs_py.query import BAD_REQUEST, BUSY, INTERNAL, MAX_COORDINATE, QueryError, error_reply, ok_reply
 from ravh_sim.errors import UserError
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.nav.planner import Path as PlannedPath
-from ravh_sim.poses import compose, relative
+from ravh_sim.poses import compose, matrix_from_quaternion, relative
 from ravh_sim.robot.profile import RobotProfile, load_profile
 from ravh_sim.robot.robot import Robot
 from ravh_sim.robot.simulation import Simulation
@@ -176,13 +178,49 @@ class SimRuntime:
                             f"{agent.profile.max_angular_speed:.3g} rad/s)")
         agent.robot.set_command(v, w)
 
-    def plan(self, start: tuple[float, float], goal: tuple[float, float]) -> PlannedPath:
-        """A GetPlan request: numbers are checked here, before they reach numpy and the planner."""
-        for name, (x, y) in (("start", start), ("goal", goal)):
-            if not all(-MAX_COORDINATE <= v <= MAX_COORDINATE for v in (x, y)):   # False for NaN too
-                raise UserError(f"rejected {name} ({shown(x)}, {shown(y)}): coordinates must be finite and "
-                                f"within +-{MAX_COORDINATE:g} m")
-        return self.navigation.plan(start, goal)
+    def plan(self, start: tuple[float, ...], goal: tuple[float, ...],
+             frames: tuple[str, str] = (names.MAP_FRAME, names.MAP_FRAME)) -> PlannedPath:
+        """A GetPlan request: start and goal (x, y[, z]) in ``frames`` (map, an agent's odom, base_link or
+        sensor frame, as on /tf; empty means map), planned in map. Numbers and frames are checked here,
+        before they reach numpy and the planner."""
+        points = []
+        for name, point, frame in (("start", start, frames[0]), ("goal", goal, frames[1])):
+            if not all(-MAX_COORDINATE <= v <= MAX_COORDINATE for v in point):   # False for NaN too
+                raise UserError(f"rejected {name} ({', '.join(shown(v) for v in point)}): coordinates must be "
+                                f"finite and within +-{MAX_COORDINATE:g} m")
+            try:
+                points.append(self.to_map(frame, *point))
+            except UserError as e:
+                raise UserError(f"rejected {name}: {e}") from None
+        return self.navigation.plan(points[0], points[1])
+
+    def to_map(self, frame: str, x: float, y: float, z: float = 0.0) -> tuple[float, float]:
+        """(x, y) in map of a point given in ``frame``: map (or empty), an agent's odom, base_link or one
+        of its sensor frames, named as the sim publishes them on /tf (``robot2/odom`` for a second agent).
+        The transforms are the ones on /tf now: the ground-truth map -> odom, odometry, the mounts."""
+        name = frame.lstrip("/")
+        if name in ("", names.MAP_FRAME):
+            return (x, y)
+        known = [names.MAP_FRAME]
+        for agent in self.agents:
+            def own(base: str, a: Agent = agent) -> str:
+                return names.agent_name(base, a.name, a.first)
+            mounts = {own(child): (own(parent), xyz, quat)
+                      for parent, child, xyz, quat in self.static_transforms(agent)}
+            known += [own(names.ODOM_FRAME), own(names.BASE_FRAME), *mounts]
+            if name == own(names.ODOM_FRAME):
+                ox, oy, _ = compose(self.map_to_odom(agent), (x, y, 0.0))
+                return (ox, oy)
+            point, at = np.array([x, y, z]), name
+            while at in mounts:                       # up the mounts to base_link
+                parent, xyz, (qx, qy, qz, qw) = mounts[at]
+                point = matrix_from_quaternion((qx, qy, qz, qw)) @ point + np.asarray(xyz, float)
+                at = parent
+            if at == own(names.BASE_FRAME):
+                base = compose(self.map_to_odom(agent), agent.robot.odometry)     # map -> odom -> base_link
+                bx, by, _ = compose(base, (float(point[0]), float(point[1]), 0.0))
+                return (bx, by)
+        raise UserError(f"unknown frame {shown(frame)}; known: {', '.join(known)}")
 
     def reset(self) -> None:
         """Agents back to their start poses, stopped; appearance back to the initial settings."""
@@ -194,6 +232,22 @@ class SimRuntime:
     # ------------------------------------------------------------------ JSON services
     def query(self, text: str) -> dict[str, Any]:
         return self.ground_truth.answer(text)
+
+    def appearance_refusal(self, text: str | dict, busy: Callable[[], str | None]) -> dict[str, Any] | None:
+        """The error reply to an appearance request refused without touching the world (None: go on
+        with :meth:`change_appearance`): one that does not parse or names what the house lacks gets its
+        own error; then ``busy()``, a reason it cannot be done now, makes a "busy" reply. Cheap, and
+        safe on any thread: it reads only the request and the house."""
+        try:
+            self.appearance.check_names(appearance_lang.parse(text))
+        except QueryError as e:
+            return e.reply()
+        except UserError as e:
+            return error_reply(BAD_REQUEST, str(e), getattr(e, "valid", None))
+        except Exception as e:  # a request must never take the node down
+            return error_reply(INTERNAL, f"{type(e).__name__}: {e}")
+        why = busy()
+        return None if why is None else error_reply(BUSY, why)
 
     def change_appearance(self, text: str | dict) -> dict[str, Any]:
         """Apply an appearance request (ravh_msgs_py.appearance); never raises."""

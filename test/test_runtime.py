@@ -253,3 +253,57 @@ def test_huge_requests_are_refused_without_echo(runtime, request_):
 def test_appearance_numbers_are_checked(runtime, key, value):
     reply = runtime.change_appearance(json.dumps({key: value}))
     assert reply["error"]["code"] in ("bad_request", "unknown_id"), reply
+
+
+# ------------------------------------------------------------------ GetPlan frames (issue 24)
+
+def test_points_in_odom_and_agent_frames_are_transformed_into_map(runtime):
+    agent = runtime.agents[0]
+    runtime.command(agent, 0.3, 0.4)
+    runtime.step(600)                                           # odometry drifts away from the truth
+    runtime.command(agent, 0.0, 0.0)
+    x, y, yaw = agent.robot.pose
+    ox, oy, _ = agent.robot.odometry
+    assert runtime.to_map("odom", ox, oy) == pytest.approx((x, y), abs=1e-9)  # odom -> base_link is odometry
+    assert runtime.to_map("base_link", 0.0, 0.0) == pytest.approx((x, y), abs=1e-9)
+    assert runtime.to_map("/base_link", 1.0, 0.0) == pytest.approx((x + math.cos(yaw), y + math.sin(yaw)))
+    assert runtime.to_map("map", 2.5, -1.0) == runtime.to_map("", 2.5, -1.0) == (2.5, -1.0)
+    # 1 m along the optical axis: ahead of the camera (pitched down a little), whatever the mount height
+    cx, cy = runtime.to_map("camera_optical_frame", 0.0, 0.0, 1.0)
+    ahead = (cx - x) * math.cos(yaw) + (cy - y) * math.sin(yaw)
+    assert 0.9 < ahead < 1.1 and abs((cy - y) * math.cos(yaw) - (cx - x) * math.sin(yaw)) < 1e-6
+    assert runtime.to_map("laser_link", 0.5, 0.0) == pytest.approx(runtime.to_map("base_link", 0.5, 0.0))
+
+
+@pytest.mark.parametrize("frame", ["kitchen", "robot2/odom", "odom_combined", "world"])
+def test_unknown_frames_are_refused_with_the_known_ones(runtime, frame):
+    with pytest.raises(UserError, match=f"unknown frame '{frame}'; known: map, odom, base_link"):
+        runtime.to_map(frame, 0.0, 0.0)
+    with pytest.raises(UserError, match="rejected goal: unknown frame"):
+        runtime.plan((-3.0, 1.6), (-2.0, 1.6), ("map", frame))
+
+
+def test_a_plan_from_the_robot_in_base_link_starts_where_the_robot_is(runtime):
+    agent = runtime.agents[0]
+    x, y, _ = agent.robot.pose
+    goal = runtime.to_map("base_link", 0.0, 0.0)
+    in_map = runtime.plan((x, y), (-3.0, 1.6))
+    in_base = runtime.plan((0.0, 0.0, 0.0), (-3.0, 1.6, 0.0), ("base_link", "map"))
+    ox, oy, _ = agent.robot.odometry
+    in_odom = runtime.plan((ox, oy), (-3.0, 1.6), ("odom", "map"))
+    assert in_base.points == in_map.points == in_odom.points and goal == pytest.approx((x, y))
+
+
+def test_an_appearance_request_is_refused_as_busy_only_once_it_reads_well(runtime):
+    asked = []
+
+    def busy() -> str:
+        asked.append(1)
+        return "the sim is busy"
+
+    bad = runtime.appearance_refusal({"doors": {"Door_99": "open"}}, busy)
+    assert bad["error"]["code"] == "unknown_id" and "Door_0" in bad["error"]["valid"] and not asked
+    assert runtime.appearance_refusal("{not json", busy)["error"]["code"] == "bad_json" and not asked
+    refused = runtime.appearance_refusal({"sun_angle": "night"}, busy)
+    assert refused == {"ok": False, "error": {"code": "busy", "message": "the sim is busy"}} and asked
+    assert runtime.appearance_refusal({"sun_angle": "night"}, lambda: None) is None

@@ -436,3 +436,32 @@ def test_oversized_requests_are_refused_and_not_kept(sim):
     assert after_six - after_two < 5, (before, after_two, after_six)
     assert after_six - before < 40, (before, after_two, after_six)
     assert proc.alive()
+
+
+def test_get_plan_takes_start_and_goal_in_odom_or_an_agent_frame(sim):
+    """Issue 24: a start stamped in odom or base_link was planned as if it were in map. (Last: its refusals
+    are logged as warnings, which are throttled.)"""
+    _, probe = sim
+    probe.got[n.GROUND_TRUTH_POSE].clear()
+    assert spin_until(probe.node, lambda: probe.got[n.GROUND_TRUTH_POSE], 10)
+    truth = probe.got[n.GROUND_TRUTH_POSE][-1].pose.position
+
+    grid = convert.grid_of(probe.call(GetMap, n.GET_FREE_SPACE_SERVICE, GetMap.Request()).map)
+    free = grid.center_of(*np.argwhere(grid.data == FREE)[-1])
+
+    def plan(start_frame: str, goal_frame: str = n.MAP_FRAME, goal=free, start=(0.0, 0.0)) -> list[tuple[float, float]]:
+        req = GetPlan.Request()
+        req.start.header.frame_id, req.goal.header.frame_id = start_frame, goal_frame
+        req.start.pose.position.x, req.start.pose.position.y = start
+        req.goal.pose.position.x, req.goal.pose.position.y = goal
+        reply = probe.call(GetPlan, n.GET_PLAN_SERVICE, req).plan
+        assert reply.header.frame_id == n.MAP_FRAME
+        return [(p.pose.position.x, p.pose.position.y) for p in reply.poses]
+
+    from_robot = plan(n.BASE_FRAME)                             # (0, 0) in base_link: where the robot is
+    assert from_robot and math.dist(from_robot[0], (truth.x, truth.y)) < 0.1
+    assert plan(n.LASER_FRAME)[0] == pytest.approx(from_robot[0], abs=1e-6)
+    assert plan(n.MAP_FRAME)[:1] != from_robot[:1]              # (0, 0) in map is elsewhere (or no start)
+    to_robot = plan(n.MAP_FRAME, n.BASE_FRAME, goal=(0.0, 0.0), start=free)
+    assert math.dist(to_robot[-1], (truth.x, truth.y)) < 0.1
+    assert plan("kitchen") == [] and plan(n.MAP_FRAME, "odom_combined") == []     # unknown: refused

@@ -53,7 +53,7 @@ from tf2_msgs.msg import TFMessage
 
 from ravh_msgs_py import names as n
 from ravh_msgs_py.capture import CaptureEvent
-from ravh_msgs_py.query import BUSY, MAX_REQUEST_CHARS, error_reply
+from ravh_msgs_py.query import MAX_REQUEST_CHARS
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nodes import convert
@@ -488,18 +488,17 @@ class SimNode(Node):
         return response
 
     def _on_appearance(self, request: AddDiagnostics.Request, response: AddDiagnostics.Response):
-        busy = self._busy()
-        if busy is not None:
-            reply = error_reply(BUSY, busy)
-        else:
-            start = time.monotonic()
+        start = time.monotonic()
+        # read and checked here (cheap, no state), so a bad or a refused request never waits for a frame
+        reply = self.runtime.appearance_refusal(request.load_namespace, self._busy)
+        if reply is None:
             # on the render thread: a renderer reads the world's appearance while it renders
             reply = self._on_render_thread(self.runtime.change_appearance, request.load_namespace)
-            if reply["ok"]:
-                self._changes_in_batch += 1
-                self._publish_footprint()            # /map follows on the next step if doors changed
-                self._charged = {(agent.name, port.name) for agent in self.runtime.agents for port in SENSORS}
-                self._change_budget.spend(time.monotonic() - start)
+        if reply["ok"]:
+            self._changes_in_batch += 1
+            self._publish_footprint()            # /map follows on the next step if doors changed
+            self._charged = {(agent.name, port.name) for agent in self.runtime.agents for port in SENSORS}
+            self._change_budget.spend(time.monotonic() - start)
         response.success, response.message = bool(reply["ok"]), json.dumps(reply)
         _forget_if_oversized(request)
         return response
@@ -511,11 +510,11 @@ class SimNode(Node):
 
     def _on_get_plan(self, request: GetPlan.Request, response: GetPlan.Response):
         rt = self.runtime
-        start = (request.start.pose.position.x, request.start.pose.position.y)
-        goal = (request.goal.pose.position.x, request.goal.pose.position.y)
+        start, goal = (request.start.pose.position, request.goal.pose.position)
+        frames = (request.start.header.frame_id, request.goal.header.frame_id)
         response.plan.header = convert.header(self._now(), n.MAP_FRAME)
-        try:
-            path = rt.plan(start, goal)
+        try:       # start and goal in map, odom or an agent's frame; the plan in map; an unknown frame: no plan
+            path = rt.plan((start.x, start.y, start.z), (goal.x, goal.y, goal.z), frames)
         except UserError as e:
             self._warn(f"GetPlan: {e}")
             return response

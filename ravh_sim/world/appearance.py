@@ -218,7 +218,7 @@ class Appearance:
     def target(self, request: dict[str, Any]) -> Resolved:
         """The settings a parsed appearance request asks for: the current ones with the items it names
         resolved; changes nothing. Unknown names and impossible values are refused here."""
-        self._check_names(request)
+        self.check_names(request)
         lights, doors, rooms, models = {}, {}, {}, {}
         inherit = {}
         for which, state in request.get("lights", {}).items():
@@ -283,7 +283,9 @@ class Appearance:
     def _named(name: str, known: Mapping[str, Any]) -> list[str]:
         return list(known) if name == "all" else [name]
 
-    def _check_names(self, request: dict[str, Any]) -> None:
+    def check_names(self, request: dict[str, Any]) -> None:
+        """Refuse (QueryError unknown_id) a parsed request that names a door, light, room or object the
+        house lacks; cheap: nothing is resolved."""
         h = self.house
         for key, kind, known, groups in (("doors", "door", h.door_by_id, ("all",)),
                                          ("lights", "light", h.light_by_id, LIGHT_GROUPS),
