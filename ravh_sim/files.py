@@ -29,9 +29,22 @@ def atomic_write(path: Path, data: bytes) -> None:
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)
-    except BaseException:                 # full disk, Ctrl-C: no half-written file stays behind
+    except OSError as e:                  # full disk: no half-written file, and the error names the file
+        tmp.unlink(missing_ok=True)
+        raise named(e, path) from None
+    except BaseException:                 # Ctrl-C: no half-written file stays behind
         tmp.unlink(missing_ok=True)
         raise
+
+
+def named(error: OSError, path: Path | str) -> OSError:
+    """``error`` naming ``path``: a failed write() or fsync() (a full disk) says no file of its own, and
+    one on a temporary file should name the file it was for."""
+    if error.filename is not None and not Path(error.filename).name.startswith(TMP_PREFIX):
+        return error
+    named_error = OSError(error.errno, error.strerror or str(error), str(path))
+    named_error.__traceback__ = error.__traceback__
+    return named_error
 
 
 def write_image(path: Path, image: np.ndarray) -> None:

@@ -158,6 +158,25 @@ def test_a_failed_raid_is_named_and_the_exit_status_is_not_zero(tmp_path):
     assert len(_complete(tmp_path / "house20" / "raid1")) == 3              # the others still ran
 
 
+def test_a_full_disk_names_the_file_and_the_progress_bar_shows_the_failed_raid(tmp_path):
+    """Issue 24: a full disk said 'OSError: [Errno 28] No space left on device' without the file, and the
+    bar showed the failed raid as 1/1 100 %. Writes past a file-size limit fail as on a full disk."""
+    import resource
+
+    def small_files() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (150_000, resource.getrlimit(resource.RLIMIT_FSIZE)[1]))
+
+    run = _ravh("dataset", "build", "--houses", "20", "--raids", "1", "--out", str(tmp_path), "--max-captures", "3",
+                preexec_fn=small_files)
+    _, stderr = run.communicate(timeout=300)
+    assert run.returncode == 1
+    folder = tmp_path / "house20" / "raid1"
+    failure = next(line for line in stderr.splitlines() if "failed:" in line)
+    assert f"ravh: raid house20/raid1 failed: {folder}/" in failure and ": File too large" in failure
+    bars = [line for line in stderr.replace("\r", "\n").splitlines() if "raid/s" in line]
+    assert "1 raid FAILED" in bars[-1] and "0/1" in bars[-1] and "1/1" not in stderr and "100%" not in stderr
+
+
 class RayCluster:
     """A head and one worker node started with ``ray start --block`` on this machine, each in its own
     process group so that stopping them touches nothing else."""

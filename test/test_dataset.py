@@ -195,9 +195,11 @@ def test_a_full_disk_stops_a_capture_without_a_torn_file(tmp_path, footprint20):
             line = (root / layout.CAPTURES_JSONL).stat().st_size
             writer.write_capture(event(float(k), room), blank)
     assert full.value.errno == errno.EFBIG and 0 < writer.count < 100
+    assert full.value.filename == str(root / layout.CAPTURES_JSONL)      # the error names the file (issue 24)
     assert (root / layout.CAPTURES_JSONL).stat().st_size == line        # the part-written line was cut off
-    with file_size_limit(2000), pytest.raises(OSError):                 # an image does not fit
+    with file_size_limit(2000), pytest.raises(OSError) as image:        # an image does not fit
         writer.write_capture(event(99.0, room), capture(np.random.default_rng(0), []))
+    assert image.value.filename.startswith(str(root)) and not Path(image.value.filename).name.startswith(".")
     writer.close()
     everything = [p for p in root.rglob("*") if p.is_file()]
     assert [p for p in everything if p.name.startswith(layout.TMP_PREFIX) or p.stat().st_size == 0] == []

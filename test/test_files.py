@@ -46,8 +46,10 @@ def test_a_failed_fsync_keeps_the_old_file(tmp_path, monkeypatch):
         raise OSError(errno.ENOSPC, "No space left on device")
 
     monkeypatch.setattr(files.os, "fsync", no_space)
-    with pytest.raises(OSError, match="No space"):
+    with pytest.raises(OSError, match="No space") as e:
         files.atomic_write(path, b"new\n")
+    assert e.value.filename == str(path) and e.value.errno == errno.ENOSPC     # names the file (issue 24)
+    assert f"No space left on device: '{path}'" in str(e.value)
     assert path.read_bytes() == b"old\n" and leftovers(tmp_path) == []
     with pytest.raises(OSError, match="No space"):
         files.atomic_write(tmp_path / "new.json", b"new\n")

@@ -206,7 +206,7 @@ def build(root: Path, houses: list[int], raids: list[int], workers: int = 1, eng
             done[job] = summary
         else:
             failed[job.name] = error or f"status: {summary.get('status') if summary else 'none'}"
-        progress.raid_done(job)
+        progress.raid_done(job, job.name not in failed)
 
     start = time.monotonic()
     try:
@@ -286,19 +286,24 @@ def _run_job_on_ray(job: Job, root: Path, options: BuildOptions) -> dict[str, An
 
 
 def _describe(error: BaseException | None) -> str | None:
+    """One line for a raid's failure; a write error (a full disk) names the file, as ``ravh`` does."""
     if error is None:
         return None
+    if isinstance(error, OSError) and error.strerror:
+        return f"{error.filename}: {error.strerror}" if error.filename else f"{error.strerror} (errno {error.errno})"
     return f"{type(error).__name__}: {str(error).strip().splitlines()[-1] if str(error).strip() else ''}"
 
 
 class Progress:
     """A tqdm bar over the raids to run, with the captures written so far (read from the raids'
-    captures.jsonl, wherever the worker runs), captures per second and tqdm's ETA."""
+    captures.jsonl, wherever the worker runs), captures per second and tqdm's ETA. A raid that fails
+    does not advance the bar: it is counted as failed beside it, and the bar turns red."""
 
     def __init__(self, root: Path, todo: list[Job], show: bool) -> None:
         from tqdm import tqdm
         self.root, self.open = root, set(todo)
         self.closed_captures = 0
+        self.failed = 0
         self.start = time.monotonic()
         self.bar = tqdm(total=len(todo), unit="raid", disable=not show, file=sys.stderr,
                         dynamic_ncols=True, smoothing=0.1)
@@ -310,12 +315,18 @@ class Progress:
     def poll(self) -> None:
         captures = self.captures()
         rate = captures / max(time.monotonic() - self.start, 1e-9)
-        self.bar.set_postfix_str(f"{captures} captures, {rate:.1f} captures/s", refresh=True)
+        failed = f", {self.failed} raid{'s' if self.failed > 1 else ''} FAILED" if self.failed else ""
+        self.bar.set_postfix_str(f"{captures} captures, {rate:.1f} captures/s{failed}", refresh=True)
 
-    def raid_done(self, job: Job) -> None:
+    def raid_done(self, job: Job, ok: bool = True) -> None:
         self.open.discard(job)
         self.closed_captures += _lines(self.root / job.name / layout.CAPTURES_JSONL)
-        self.bar.update(1)
+        if ok:
+            self.bar.update(1)
+        else:
+            self.failed += 1
+            self.bar.colour = "red"
+            self.poll()
 
     def close(self) -> None:
         self.poll()

@@ -110,7 +110,7 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
     start, cpu_start = time.monotonic(), time.process_time()
     with DatasetWriter(out) as writer:         # refuses a folder with a dataset before writing anything
         settings_path = out / SETTINGS_FILE
-        settings_path.write_text(yaml.safe_dump(settings or {}, sort_keys=False))
+        layout.atomic_write(settings_path, yaml.safe_dump(settings or {}, sort_keys=False).encode())
         runtime = SimRuntime(house, settings_path, seed, renderer=renderer)
         try:
             meta = {"house": runtime.house.number, "engine": "direct", "behaviour": _describe(spec),

@@ -20,6 +20,7 @@ from typing import Any
 from ravh_msgs_py.capture import CaptureEvent
 from ravh_sim.dataset import layout
 from ravh_sim.errors import UserError
+from ravh_sim.files import named
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.mapio import write_map
 from ravh_sim.sensors.suite import SENSORS, capture_files
@@ -118,10 +119,10 @@ class DatasetWriter:
             while done < len(line):
                 done += self._rows.write(line[done:])
             os.fsync(self._rows.fileno())
-        except OSError:
+        except OSError as e:
             os.ftruncate(self._rows.fileno(), start)
             self._rows.seek(start)
-            raise
+            raise named(e, self.dir / layout.CAPTURES_JSONL) from None
 
     def close(self) -> None:
         self._rows.close()
