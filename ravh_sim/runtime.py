@@ -238,27 +238,17 @@ class SimRuntime:
         with :meth:`change_appearance`): one that does not parse or names what the house lacks gets its
         own error; then ``busy()``, a reason it cannot be done now, makes a "busy" reply. Cheap, and
         safe on any thread: it reads only the request and the house."""
-        try:
-            self.appearance.check_names(appearance_lang.parse(text))
-        except QueryError as e:
-            return e.reply()
-        except UserError as e:
-            return error_reply(BAD_REQUEST, str(e), getattr(e, "valid", None))
-        except Exception as e:  # a request must never take the node down
-            return error_reply(INTERNAL, f"{type(e).__name__}: {e}")
+        refused = _replying(lambda: self.appearance.check_names(appearance_lang.parse(text)))
+        if refused is not None:
+            return refused
         why = busy()
         return None if why is None else error_reply(BUSY, why)
 
     def change_appearance(self, text: str | dict) -> dict[str, Any]:
         """Apply an appearance request (ravh_msgs_py.appearance); never raises."""
-        try:
-            return ok_reply(self.appearance.change(appearance_lang.parse(text)))
-        except QueryError as e:
-            return e.reply()
-        except UserError as e:
-            return error_reply(BAD_REQUEST, str(e), getattr(e, "valid", None))
-        except Exception as e:  # a request must never take the node down
-            return error_reply(INTERNAL, f"{type(e).__name__}: {e}")
+        reply = _replying(lambda: ok_reply(self.appearance.change(appearance_lang.parse(text))))
+        assert reply is not None, "an ok reply or an error reply"
+        return reply
 
     def footprint(self) -> dict[str, Any]:
         """The footprint of the world as the sensors see it now."""
@@ -271,3 +261,15 @@ class SimRuntime:
                 if close is not None:
                     close()
         self.world.close()
+
+
+def _replying(act: Callable[[], dict[str, Any] | None]) -> dict[str, Any] | None:
+    """What ``act`` returns, or the error reply of what it raised: a request never takes the node down."""
+    try:
+        return act()
+    except QueryError as e:
+        return e.reply()
+    except UserError as e:
+        return error_reply(BAD_REQUEST, str(e), getattr(e, "valid", None))
+    except Exception as e:
+        return error_reply(INTERNAL, f"{type(e).__name__}: {e}")
