@@ -46,7 +46,7 @@ def test_auto_exposure_lengthens_the_frame_then_raises_the_gain_then_gives_up():
 def test_noise_grows_as_light_falls_and_the_darkest_room_stays_dark():
     sensor = SensorModel()
     noise, brightness = [], []
-    for luminance in (1.0, 0.25, 0.05, 0.01, 0.001):
+    for luminance in DAYLIT_LUMINANCE * np.array([2.0, 0.5, 0.1, 0.02, 0.002]):
         rgb, exposure = sensor.expose(room(luminance), rng())
         flat = rgb[:, 5:W // 2 - 5].astype(float)                    # one flat wall
         noise.append(flat.std())

@@ -84,7 +84,8 @@ def _sweep(image: np.ndarray, K: np.ndarray, linear: float, angular: float, expo
 
 # ---------------------------------------------------------------------------- the sensor
 
-DAYLIT_LUMINANCE = 0.5        # mean linear luminance of a daylit room in the renderer's light units
+DAYLIT_LUMINANCE = 1.45       # mean linear luminance of a daylit room in the renderer's light units (house 20
+                              # at its station by day; windows as area lights of the bright outdoors)
 LUMA = np.array([0.2126, 0.7152, 0.0722], np.float32)       # Rec. 709 luminance of linear RGB
 
 
