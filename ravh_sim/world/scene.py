@@ -29,7 +29,6 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pybullet as pb
-import trimesh
 
 from ravh_sim.poses import quaternion_from_yaw
 from ravh_sim.render.backend import resolve_backend
@@ -232,7 +231,7 @@ class World:
     def _model_collision(self, fitted: FittedModel) -> int:
         """A library model collides as its own triangles (a static concave mesh: exact for the laser,
         which then sees what the camera draws), loaded from a cached OBJ file."""
-        mesh = trimesh.Trimesh(fitted.vertices, fitted.model.faces, process=False)
+        mesh = fitted.mesh
         key = fitted.model.id.encode() + np.round(fitted.vertices, 5).tobytes()
         path = self._asset(key, ".obj", lambda p: mesh.export(p, file_type="obj", include_normals=False,
                                                               include_texture=False))
