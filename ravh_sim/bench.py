@@ -329,9 +329,9 @@ def bench_raid(houses: list[int] | None = None) -> dict[str, Any]:
     import resource
     from pathlib import Path
 
-    from ravh_sim.dataset.build import BuildOptions, Job, raid_seed, run_job
-    from ravh_sim.dataset.raid import PRESETS, run_raid
     from ravh_sim.paper import table2
+    from ravh_sim.raids.build import BuildOptions, Job, raid_seed, run_job
+    from ravh_sim.raids.raid import PRESETS, run_raid
     from ravh_sim.world.house import available_houses, load_house
 
     def floor_area(n: int) -> float:

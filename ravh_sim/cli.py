@@ -18,11 +18,11 @@ from typing import Any
 from ravh_msgs_py.appearance import DOOR, SWITCH
 from ravh_msgs_py.names import DEFAULT_PROFILE
 from ravh_sim.bench import BENCHES
-from ravh_sim.dataset.build import add_parser as add_dataset_parser
 from ravh_sim.errors import UserError
 from ravh_sim.nodes.launch import NODES
 from ravh_sim.nodes.launch import main as launch_node
 from ravh_sim.paths import FURNITURE_DIR, HOUSES_DIR
+from ravh_sim.raids.build import add_parser as add_dataset_parser
 from ravh_sim.render.backend import BACKENDS
 
 Command = Callable[[argparse.Namespace], int]
@@ -212,7 +212,7 @@ def _sun_value(text: str) -> float | str:
 
 
 def cmd_raid(args: argparse.Namespace) -> int:
-    from ravh_sim.dataset.raid import INTERRUPTED, run_raid
+    from ravh_sim.raids.raid import INTERRUPTED, run_raid
     from ravh_sim.world.house import available_houses, load_house
     houses = available_houses() if args.all else [args.house]
     if not args.all:
@@ -241,7 +241,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 def cmd_raid_summary(args: argparse.Namespace) -> int:
     from ravh_sim.dataset.api import Dataset
-    from ravh_sim.dataset.summary import write_summary
+    from ravh_sim.raids.summary import write_summary
     dataset = Dataset(args.dataset)
     write_summary(dataset, args.output)
     print(f"wrote {args.output} ({len(dataset)} captures)")

@@ -16,7 +16,7 @@ _recorded: dict[str, Path] = {}
 def small_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A 12-capture dataset of house 20 (day light), shared by every test that asks for it."""
     if "small" not in _recorded:
-        from ravh_sim.dataset.direct import PosesSpec, record
+        from ravh_sim.raids.direct import PosesSpec, record
         poses = tuple((x, y, 2 * math.pi * k / HEADINGS) for x, y in SPOTS for k in range(HEADINGS))
         out = tmp_path_factory.mktemp("eval") / "h20_small"
         record(out, 20, PosesSpec(poses), seed=5)

@@ -17,8 +17,8 @@ from conftest import ROOT, subprocess_env
 
 import ravh_sim
 from ravh_sim.dataset.api import Dataset
-from ravh_sim.dataset.build import build, parse_numbers, raid_seed, summary_table
 from ravh_sim.errors import UserError
+from ravh_sim.raids.build import build, parse_numbers, raid_seed, summary_table
 
 SMALL = ("--max-nodes", "1", "--max-captures", "12")        # grid: one node; wanderer: 12 captures
 
@@ -236,7 +236,7 @@ def test_ray_cluster_of_two_nodes_builds_two_raids(tmp_path):
     runs it): one raid per node, and the same files as a build on the local pool."""
     cluster = RayCluster(tmp_path)
     out = tmp_path / "shared"
-    driver = ("import json, sys; from pathlib import Path; from ravh_sim.dataset.build import build; "
+    driver = ("import json, sys; from pathlib import Path; from ravh_sim.raids.build import build; "
               "print(json.dumps(build(Path(sys.argv[1]), [20], [0, 1], ray_address=sys.argv[2], max_nodes=1, "
               "max_captures=12, show_progress=False)))")
     try:

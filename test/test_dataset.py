@@ -23,11 +23,11 @@ from ravh_msgs_py import names as n
 from ravh_msgs_py.capture import CaptureEvent
 from ravh_sim.dataset import layout
 from ravh_sim.dataset.api import MIN_PIXELS, Dataset
-from ravh_sim.dataset.summary import render_summary, write_summary
 from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid
 from ravh_sim.nodes import convert
+from ravh_sim.raids.summary import render_summary, write_summary
 from ravh_sim.sensors import imaging
 from ravh_sim.sensors.readings import CameraInfo, Scan
 from ravh_sim.sensors.suite import capture_files

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from ravh_sim.dataset.api import Dataset
-from ravh_sim.dataset.direct import GridSpec, PosesSpec, WandererSpec, record
 from ravh_sim.errors import UserError
+from ravh_sim.raids.direct import GridSpec, PosesSpec, WandererSpec, record
 
 SMALL_GRID = GridSpec(max_nodes=1, captures_per_node=4)
 
@@ -90,7 +90,7 @@ def ros_grid_raid(tmp_path_factory):
     """One small grid raid (one node, ten captures) through the ROS engine's three processes."""
     from rosgraph import ros_env
 
-    from ravh_sim.dataset.raid import run_raid
+    from ravh_sim.raids.raid import run_raid
     out = tmp_path_factory.mktemp("ros") / "raid0"
     with pytest.MonkeyPatch.context() as mp:
         for key, value in ros_env().items():
@@ -101,7 +101,7 @@ def ros_grid_raid(tmp_path_factory):
 
 
 def test_both_engines_write_datasets_the_api_reads_the_same_way(tmp_path, ros_grid_raid):
-    from ravh_sim.dataset.raid import PRESETS, preset_settings
+    from ravh_sim.raids.raid import PRESETS, preset_settings
     ros_summary, ros_dir = ros_grid_raid
     seed = ros_summary["seed"]
     direct = record(tmp_path / "direct", 20, GridSpec(max_nodes=1), settings=preset_settings(PRESETS[0], seed),
@@ -128,7 +128,7 @@ def test_both_engines_write_datasets_the_api_reads_the_same_way(tmp_path, ros_gr
 def test_the_same_poses_give_the_same_images_in_both_engines(tmp_path, ros_grid_raid):
     """Replay the ROS raid's recorded poses with the direct engine: every image is identical
     (colour, depth and instances; the camera sees only the pose and the world's settings)."""
-    from ravh_sim.dataset.raid import PRESETS, preset_settings
+    from ravh_sim.raids.raid import PRESETS, preset_settings
     ros_summary, ros_dir = ros_grid_raid
     ros = Dataset(ros_dir)
     poses = tuple(s.pose for s in ros)

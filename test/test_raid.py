@@ -15,9 +15,9 @@ import pytest
 from rosgraph import NodeProcess, ros_env
 
 from ravh_sim.dataset.api import Dataset
-from ravh_sim.dataset.raid import PRESETS, _final_status, _rows, preset_settings, run_raid
 from ravh_sim.errors import UserError
 from ravh_sim.nodes.common import SIM_LOST_S
+from ravh_sim.raids.raid import PRESETS, _final_status, _rows, preset_settings, run_raid
 
 
 @pytest.fixture

@@ -83,10 +83,10 @@ def cmd_eval_semantic_map(args: argparse.Namespace) -> int:
 
 
 def _paper_protocol(args: argparse.Namespace, threshold: float, paper_path: Path) -> int:
-    from ravh_sim.dataset.build import parse_numbers
     from ravh_sim.errors import UserError
     from ravh_sim.eval.mappers import MAPPERS
     from ravh_sim.eval.table3 import run_protocol
+    from ravh_sim.raids.build import parse_numbers
     from ravh_sim.world.house import available_houses
     if args.out is None:
         raise UserError("--paper-protocol needs --out (the raids are recorded there and reused)")

@@ -14,10 +14,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ravh_sim.dataset.build import clear_unfinished, finished
 from ravh_sim.eval.semantic_eval import DEFAULT_THRESHOLD, evaluate_datasets, format_beside_paper
 from ravh_sim.eval.semantic_map import write_map
 from ravh_sim.paper import TABLE3, read_tsv
+from ravh_sim.raids.build import clear_unfinished, finished
 
 RANDOM_APPEARANCE = {"lights": {"sun_angle": "random", "ceiling": "random", "lamps": "random"},
                      "paint": {"walls": "random", "floors": "random"}, "models": {"all": "random"}}
@@ -25,7 +25,7 @@ RANDOM_APPEARANCE = {"lights": {"sun_angle": "random", "ceiling": "random", "lam
 
 def record_house(house: int, out: Path, seed: int) -> Path:
     """The protocol's raid of ``house`` under ``out`` (recorded unless a finished one is there)."""
-    from ravh_sim.dataset.direct import WandererSpec, record
+    from ravh_sim.raids.direct import WandererSpec, record
     folder = out / f"house{house:02d}"
     if finished(folder) is None:
         clear_unfinished(folder)

@@ -27,11 +27,11 @@ import numpy as np
 
 from ravh_sim.behaviours.waypoints import Layout, grid_nodes
 from ravh_sim.dataset.api import Dataset
-from ravh_sim.dataset.direct import MAX_SIM_S, GridSpec, PosesSpec, WandererSpec, record
 from ravh_sim.dataset.layout import RAID_JSON
 from ravh_sim.errors import UserError
 from ravh_sim.eval.descriptors import Descriptor, describe, load_descriptor
 from ravh_sim.eval.localization import Localizer, errors, noisy_odometry
+from ravh_sim.raids.direct import MAX_SIM_S, GridSpec, PosesSpec, WandererSpec, record
 
 RUNS = 5
 SPEED = 0.25                       # m/s, the Wanderer's cruise speed (the giraff profile's maximum)

@@ -13,7 +13,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ravh_sim.dataset.raid import PRESETS, preset_settings
+from ravh_sim.raids.raid import PRESETS, preset_settings
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.sensors.camera import SmartCamera
 from ravh_sim.world.appearance import Appearance

@@ -10,7 +10,7 @@ and raid.json's ``wall_s`` and ``cpu_s`` say when and how fast it ran).
 
 The API other code calls::
 
-    from ravh_sim.dataset.direct import GridSpec, WandererSpec, PosesSpec, record
+    from ravh_sim.raids.direct import GridSpec, WandererSpec, PosesSpec, record
     summary = record("out/h20_noon", 20, GridSpec(max_nodes=5),
                      settings={"lights": {"sun_angle": 90, "ceiling": "off"}}, seed=3)
 

@@ -1,6 +1,6 @@
 """``ravh dataset build``: the paper's raids for many houses into one folder, on one machine or many.
 
-Every (house, raid) runs the paper's preset (:data:`ravh_sim.dataset.raid.PRESETS`) into
+Every (house, raid) runs the paper's preset (:data:`ravh_sim.raids.raid.PRESETS`) into
 ``OUT/houseNN/raidK`` in the dataset format, with the direct engine (one process per raid, no DDS)
 or the ROS engine (``ravh raid``'s three processes). Raids run on a local process pool, or as Ray
 tasks on a cluster (``--ray ADDRESS``; ``pip install ravh_sim[ray]``) whose nodes share OUT.
@@ -31,9 +31,9 @@ from typing import Any
 
 from ravh_sim import __version__
 from ravh_sim.dataset import layout
-from ravh_sim.dataset.raid import PRESETS, preset_settings, run_raid
 from ravh_sim.errors import UserError
 from ravh_sim.paper import RAID_COLUMNS, TABLE2, table2
+from ravh_sim.raids.raid import PRESETS, preset_settings, run_raid
 
 ENGINES = ("direct", "ros")
 POLL_S = 0.5
@@ -140,7 +140,7 @@ def run_job(job: Job, root: Path, options: BuildOptions) -> dict[str, Any]:
                         max_nodes=options.max_nodes, quiet=True, meta=recorded)
     (out / "logs").mkdir(parents=True)
     with _output_to(out / "logs" / "direct.log"):
-        from ravh_sim.dataset.direct import GridSpec, WandererSpec, record
+        from ravh_sim.raids.direct import GridSpec, WandererSpec, record
         spec = GridSpec(max_nodes=options.max_nodes) if preset.behaviour == "grid" else WandererSpec()
         return record(out, job.house, spec, settings=preset_settings(preset, job.seed), seed=job.seed,
                       max_captures=options.max_captures,
