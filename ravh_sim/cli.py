@@ -194,7 +194,7 @@ def cmd_render(args: argparse.Namespace) -> int:
 
 
 def cmd_gallery(args: argparse.Namespace) -> int:
-    from ravh_sim.viz.gallery import gallery, object_gallery
+    from ravh_sim.raids.gallery import gallery, object_gallery
     pose = tuple(args.pose) if args.pose else None
     if args.objects:
         print(f"wrote {object_gallery(args.house, args.output, args.seed, args.renderer)}")

@@ -53,3 +53,21 @@ def write_image(path: Path, image: np.ndarray) -> None:
     if not ok:
         raise OSError(f"cannot encode an image as {path.suffix!r}", str(path))
     atomic_write(path, data.tobytes())
+
+
+def encode_png(image: np.ndarray) -> bytes:
+    """PNG bytes of an 8-bit RGB (H, W, 3) or a 16-bit (H, W) image."""
+    if image.ndim == 3:
+        image = cv2.cvtColor(image, cv2.COLOR_RGB2BGR)
+    ok, buf = cv2.imencode(".png", image, [cv2.IMWRITE_PNG_COMPRESSION, 1])
+    if not ok:
+        raise ValueError(f"cannot encode a {image.dtype} {image.shape} image as PNG")
+    return buf.tobytes()
+
+
+def read_png(path: Path) -> np.ndarray:
+    """The pixels of a PNG as written by :func:`encode_png` (RGB order for colour images)."""
+    image = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    if image is None:
+        raise OSError(f"{path}: cannot read the PNG")
+    return cv2.cvtColor(image, cv2.COLOR_BGR2RGB) if image.ndim == 3 else image

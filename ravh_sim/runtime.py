@@ -148,7 +148,8 @@ class SimRuntime:
         values: dict[str, Any] = {}
         for port in SENSORS:
             data, frame = self.read(agent, port.name), names.agent_name(port.frame, agent.name, agent.first)
-            values.update({t.key: t.value(data, agent.sensors[port.name], frame) for t in port.topics if t.dataset})
+            values.update({t.key: port.value(t.key, data, agent.sensors[port.name], frame)
+                           for t in port.topics if t.dataset})
         return self.capture_event(agent), values
 
     def capture_event(self, agent: Agent) -> CaptureEvent:

@@ -1,4 +1,4 @@
-"""Dependencies point one way: processes that only navigate or run a behaviour load no simulator."""
+"""Dependencies point one way: down the layers, and navigation and behaviours load no simulator."""
 from __future__ import annotations
 
 import ast
@@ -117,6 +117,63 @@ def test_the_cycle_finder_finds_a_cycle():
     graph = {"a": {"b"}, "b": {"c"}, "c": {"b", "d"}, "d": set()}
     assert find_cycle(graph) == ["b", "c", "b"]
     assert find_cycle({"a": {"b"}, "b": {"c"}, "c": set()}) is None
+
+
+# --------------------------------------------------------------------------- layers
+
+# Lowest first: a module may import from its own layer and the layers below it, never from above, so
+# each layer can be read, tested and reused without those above it. Modules belong to the layer of
+# their longest listed prefix; packages named together in one layer are peers that import each other.
+LAYERS: list[tuple[str, ...]] = [
+    ("ravh_msgs_py", "ravh_sim", "ravh_sim.errors", "ravh_sim.paths", "ravh_sim.files", "ravh_sim.poses",
+     "ravh_sim.schema", "ravh_sim.paper"),
+    ("ravh_sim.world", "ravh_sim.render"),      # the scene picks its render backend; renderers draw the scene
+    # a robot and what it carries: profiles hold the sensors' sections, sensors read their robot; a
+    # profile's body drives the planner, agents start on its free space
+    ("ravh_sim.robot", "ravh_sim.sensors", "ravh_sim.nav"),
+    ("ravh_sim.dataset",),                       # the format: written and read through the sensor ports
+    ("ravh_sim.viz",),                           # pictures of a house
+    ("ravh_sim.behaviours",),
+    ("ravh_sim.runtime",),                       # the simulation without ROS
+    ("ravh_sim.nodes",),
+    ("ravh_sim.raids",),                         # recording datasets: ROS processes or one direct process
+    ("ravh_sim.eval",),                          # the paper's experiments, over recorded datasets
+    ("ravh_sim.bench", "ravh_sim.bench_ros", "ravh_sim.cli"),
+]
+
+
+def layer_of(module: str, layers: list[tuple[str, ...]]) -> int:
+    """The index of the layer that ``module`` belongs to (its longest listed prefix)."""
+    owners = [(len(prefix), i) for i, layer in enumerate(layers) for prefix in layer
+              if module == prefix or module.startswith(prefix + ".")]
+    if not owners:
+        raise KeyError(f"{module} is in no layer: add it to LAYERS")
+    return max(owners)[1]
+
+
+def back_arrows(graph: dict[str, set[str]], layers: list[tuple[str, ...]]) -> list[str]:
+    """The imports that point up: from a module to one in a higher layer, as "a -> b"."""
+    return sorted(f"{a} -> {b}" for a, targets in graph.items() for b in targets
+                  if layer_of(b, layers) > layer_of(a, layers))
+
+
+def test_imports_point_down_the_layers():
+    graph = import_graph()
+    assert "ravh_sim.raids.raid" in graph and "ravh_sim.nodes.common" in graph["ravh_sim.raids.raid"]
+    arrows = back_arrows(graph, LAYERS)
+    assert arrows == [], "imports that point up the layers:\n" + "\n".join(arrows)
+
+
+def test_the_layer_check_finds_an_arrow_pointing_up():
+    layers = [("base",), ("mid", "peer"), ("top",)]
+    graph = {"base.a": {"base.b"}, "base.b": set(), "mid.x": {"base.a", "peer.y"}, "peer.y": {"mid.x"},
+             "top": {"mid.x", "base.b"}}
+    assert back_arrows(graph, layers) == []
+    graph["base.b"] = {"mid.x"}
+    assert back_arrows(graph, layers) == ["base.b -> mid.x"]
+    assert layer_of("mid.x.deep", layers) == 1
+    with pytest.raises(KeyError, match="elsewhere"):
+        layer_of("elsewhere", layers)
 
 
 # --------------------------------------------------------------------------- who talks to pybullet

@@ -11,7 +11,7 @@ from evaldata import small_dataset
 from ravh_sim.cli import main
 from ravh_sim.dataset.api import Dataset
 from ravh_sim.dataset.coco import OBJECT_CLASSES, SEMANTIC_CLASSES, class_of
-from ravh_sim.dataset.layout import read_png
+from ravh_sim.files import read_png
 
 
 @pytest.fixture(scope="module")

@@ -30,7 +30,6 @@ from ravh_sim.nodes import convert
 from ravh_sim.raids.summary import render_summary, write_summary
 from ravh_sim.sensors import imaging
 from ravh_sim.sensors.readings import CameraInfo, Scan
-from ravh_sim.sensors.suite import capture_files
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.house import load_house
 
@@ -428,7 +427,7 @@ def test_a_killed_recorder_leaves_a_consistent_dataset(sim, tmp_path):
             request_capture(sim)
         assert spin_until(sim[1], lambda: rows(out) == 3, 30), rec.log()[-3000:]
         request_capture(sim)
-        first_file = out / capture_files(3)["rgb"]
+        first_file = out / layout.capture_files(3)["rgb"]
         end = time.monotonic() + 20
         while not first_file.exists() and time.monotonic() < end:   # kill it while it writes capture 3
             time.sleep(0.0005)
@@ -443,7 +442,7 @@ def test_a_killed_recorder_leaves_a_consistent_dataset(sim, tmp_path):
         assert sample.rgb.shape == (480, 640, 3) and sample.depth.shape == sample.instance.shape == (480, 640)
         assert len(sample.scan.ranges) == 360
     listed = {s.index for s in ds}
-    for kind, path in capture_files(0).items():
+    for kind, path in layout.capture_files(0).items():
         on_disk = {int(p.stem) for p in (out / kind).glob(f"*{Path(path).suffix}")}   # not torn temp files
         assert listed <= on_disk and len(on_disk - listed) <= 1, kind   # at most the in-flight capture
     assert not (out / layout.BAG_DIR / "metadata.yaml").exists()     # the bag was not closed

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from ravh_msgs_py import names as n
+from ravh_sim.dataset import layout
 from ravh_sim.dataset.api import Dataset
 from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
@@ -12,7 +13,7 @@ from ravh_sim.nodes import convert
 from ravh_sim.runtime import ODOM, SimRuntime
 from ravh_sim.sensors.ports import noise_rng
 from ravh_sim.sensors.readings import CameraInfo, Scan
-from ravh_sim.sensors.suite import SENSORS, capture_files
+from ravh_sim.sensors.suite import SENSORS
 
 EXPECTED_FIRST_DRAW = 1507402568       # numpy SeedSequence([5, 1, crc32("robot"), 0])
 
@@ -66,7 +67,7 @@ def test_each_port_reads_data_of_the_declared_shape(runtime):
         data = runtime.read(agent, port.name)
         frame = n.agent_name(port.frame, agent.name, agent.first)
         for topic in port.topics:
-            value = topic.value(data, agent.sensors[port.name], frame)
+            value = port.value(topic.key, data, agent.sensors[port.name], frame)
             msg = convert.KINDS[topic.kind].to_message(value, convert.header(runtime.time, frame))
             assert isinstance(msg, convert.KINDS[topic.kind].msg_type)
             if topic.kind == "rgb8":
@@ -91,9 +92,9 @@ def test_mounts_are_every_sensor_frame_on_base_link(runtime):
 def test_each_port_stores_the_files_it_declares(runtime):
     _, values = runtime.sample(runtime.agents[0])
     for port in SENSORS:
-        assert set(port.store(values).files) == set(port.files)
-    assert capture_files(7) == {"rgb": "rgb/000007.png", "depth": "depth/000007.png", "mask": "mask/000007.png",
-                                "scan": "scan/000007.npy"}                     # the dataset README's layout
+        assert set(port.encode(values).files) == set(port.files)
+    assert layout.capture_files(7) == {"rgb": "rgb/000007.png", "depth": "depth/000007.png",
+                                       "mask": "mask/000007.png", "scan": "scan/000007.npy"}   # the README's layout
 
 
 def test_a_sample_round_trips_through_a_dataset_and_through_the_topics(runtime, tmp_path):
@@ -115,7 +116,7 @@ def test_a_sample_round_trips_through_a_dataset_and_through_the_topics(runtime, 
             w.write_footprint(runtime.footprint())
             w.write_meta(runtime.house.number, [agent.name])
             assert w.write_capture(event, vals) == 0
-    for kind, path in capture_files(0).items():
+    for kind, path in layout.capture_files(0).items():
         assert (tmp_path / "direct" / path).read_bytes() == (tmp_path / "ros" / path).read_bytes(), kind
     ds = Dataset(tmp_path / "direct")
     sample = ds[0]
@@ -123,6 +124,8 @@ def test_a_sample_round_trips_through_a_dataset_and_through_the_topics(runtime, 
     assert sample.pose == pytest.approx(event.pose) and sample.odom == pytest.approx(event.odom)
     assert np.array_equal(sample.rgb, values["rgb"]) and np.array_equal(sample.instance, values["instance"])
     assert np.array_equal(sample.scan.ranges, values["scan"].ranges)
+    assert np.allclose(sample.depth, values["depth"], atol=0.0005, equal_nan=True)       # 1 mm steps
+    assert sample.read("mask") is sample.instance                     # decoded by its port once
     assert ds.camera[agent.name]["frame_id"] == n.CAMERA_OPTICAL_FRAME
     assert ds.camera[agent.name]["K"] == list(values["rgb_info"].K)
 

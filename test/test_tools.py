@@ -10,7 +10,7 @@ import pytest
 from conftest import ROOT, subprocess_env
 
 from ravh_sim.behaviours.teleop import ANGULAR_STEP, LINEAR_STEP, Teleop
-from ravh_sim.viz.gallery import LABEL_PX
+from ravh_sim.raids.gallery import LABEL_PX
 
 
 def ravh(*args: str, timeout: float = 300, **kwargs) -> subprocess.CompletedProcess:

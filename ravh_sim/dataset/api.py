@@ -3,8 +3,9 @@
 Which samples were taken in a room (or room type), which object types an image shows, how many
 objects or rooms of a kind the house has, which rooms the robot visited. Counts come from the
 footprint stored with the dataset, so they describe exactly the world that was recorded. Pixels are
-read lazily, one sample at a time. A dataset cut short (recorder killed) reads as the captures that
-were complete: a torn last line of captures.jsonl, or a line whose files are missing, is skipped.
+read lazily, one sample at a time, and decoded by the sensor ports that stored them. A dataset cut
+short (recorder killed) reads as the captures that were complete: a torn last line of
+captures.jsonl, or a line whose files are missing, is skipped.
 """
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ from collections import Counter
 from collections.abc import Iterator
 from functools import cached_property
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 
@@ -21,23 +22,22 @@ from ravh_sim.dataset import layout
 from ravh_sim.errors import FileFieldError, UserError
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.mapio import read_map
-from ravh_sim.sensors import imaging
+from ravh_sim.sensors.camera import CAMERA_JSON
+from ravh_sim.sensors.laser import StoredScan
+from ravh_sim.sensors.ports import SensorPort
+from ravh_sim.sensors.suite import SENSORS
 from ravh_sim.world.house import House, load_house
 from ravh_sim.world.settings import Resolved
 
 MIN_PIXELS = 50          # an instance with fewer pixels in an image does not count as visible there
 
 
-class Scan(NamedTuple):
-    """One stored laser scan: angles (rad) and ranges (m) as published (inf/NaN kept)."""
-    angles: np.ndarray
-    ranges: np.ndarray
-    range_min: float
-    range_max: float
+# file kind -> the sensor port that stores it (and so decodes it)
+PORT_OF_FILE: dict[str, SensorPort[Any, Any]] = {kind: port for port in SENSORS for kind in port.files}
 
 
 class Sample:
-    """One capture: its metadata as attributes, its pixels as lazily loaded properties."""
+    """One capture: its metadata as attributes, its sensors' data decoded by their ports on first use."""
 
     def __init__(self, root: Path, row: dict[str, Any], palette: np.ndarray) -> None:
         self.index: int = row["index"]
@@ -48,26 +48,33 @@ class Sample:
         self.room: str | None = row["room"]
         self.room_type: str | None = row["room_type"]
         self.files: dict[str, Path] = {kind: root / rel for kind, rel in row["files"].items()}
-        self._scan_meta: dict[str, float] = row["scan"]
+        self._row = row
         self._palette = palette
+        self._decoded: dict[str, Any] = {}
 
     def __repr__(self) -> str:
         return f"Sample({self.index}, t={self.stamp:.3f}, {self.agent}, room={self.room})"
 
-    @cached_property
+    def read(self, kind: str) -> Any:
+        """The data of this sample's file of ``kind`` (a sensor port's ``files``), as its port decodes it."""
+        if kind not in self._decoded:
+            self._decoded[kind] = PORT_OF_FILE[kind].decode(kind, self.files[kind], self._row)
+        return self._decoded[kind]
+
+    @property
     def rgb(self) -> np.ndarray:
         """(H, W, 3) uint8, RGB order."""
-        return layout.read_png(self.files["rgb"])
+        return self.read("rgb")
 
-    @cached_property
+    @property
     def depth(self) -> np.ndarray:
         """(H, W) float32 metres along the optical axis, NaN = no depth (1 mm steps)."""
-        return imaging.depth_from_png(layout.read_png(self.files["depth"]))
+        return self.read("depth")
 
-    @cached_property
+    @property
     def instance(self) -> np.ndarray:
         """(H, W) uint16 instance ids (footprint ids), 0 = nothing."""
-        return layout.read_png(self.files["mask"])
+        return self.read("mask")
 
     @property
     def mask(self) -> np.ndarray:
@@ -75,10 +82,9 @@ class Sample:
         ids = self.instance
         return self._palette[np.minimum(ids, len(self._palette) - 1)]
 
-    @cached_property
-    def scan(self) -> Scan:
-        data = np.load(self.files["scan"], allow_pickle=False)
-        return Scan(data[:, 0], data[:, 1], self._scan_meta["range_min"], self._scan_meta["range_max"])
+    @property
+    def scan(self) -> StoredScan:
+        return self.read("scan")
 
 
 class Dataset:
@@ -154,7 +160,7 @@ class Dataset:
     @cached_property
     def camera(self) -> dict[str, dict[str, Any]]:
         """Agent -> camera intrinsics (width, height, K row-major, D, distortion_model, frame_id)."""
-        path = self.dir / layout.CAMERA_JSON
+        path = self.dir / CAMERA_JSON
         return _read_json(path) if path.exists() else {}
 
 

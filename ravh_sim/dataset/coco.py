@@ -25,6 +25,7 @@ import numpy as np
 from ravh_sim.dataset import layout
 from ravh_sim.dataset.api import Dataset
 from ravh_sim.errors import UserError
+from ravh_sim.files import encode_png
 
 STRUCTURE_CLASSES = ("floor", "ceiling", "walls", "door", "window")
 OBJECT_CLASSES = (
@@ -89,7 +90,7 @@ def export_coco(root: Path, out: Path, min_pixels: int = 1) -> dict[str, int]:
             semantic = semantic_image(ids, table)
             target = folder / SEMANTIC_DIR / sample.files["mask"].name
             target.parent.mkdir(exist_ok=True)
-            layout.atomic_write(target, layout.encode_png(semantic))
+            layout.atomic_write(target, encode_png(semantic))
             images.append({"id": image_id, "file_name": str(sample.files["rgb"].relative_to(root)),
                            "width": width, "height": height,
                            "semantic_file": str(target.relative_to(root)),

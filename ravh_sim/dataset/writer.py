@@ -23,7 +23,7 @@ from ravh_sim.errors import UserError
 from ravh_sim.files import named
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.mapio import write_map
-from ravh_sim.sensors.suite import SENSORS, capture_files
+from ravh_sim.sensors.suite import SENSORS
 from ravh_sim.world.footprint import dump_footprint
 
 
@@ -40,7 +40,7 @@ class DatasetWriter:
                 self._rows = open(self.dir / layout.CAPTURES_JSONL, "xb", buffering=0)
             except FileExistsError:
                 raise UserError(f"{self.dir} already holds {layout.CAPTURES_JSONL}; record into a new folder") from None
-            for kind in capture_files(0):
+            for kind in layout.capture_files(0):
                 (self.dir / kind).mkdir(exist_ok=True)
         except OSError as e:
             raise UserError(f"{e.filename or self.dir}: cannot write the dataset: {e.strerror}") from None
@@ -87,13 +87,13 @@ class DatasetWriter:
         sensor port turns its own into files and fields.
         """
         index = self.count
-        files = capture_files(index)
+        files = layout.capture_files(index)
         room = event.room
         row: dict[str, Any] = {"index": index, "stamp": float(event.stamp), "agent": event.agent,
                                "pose": [float(v) for v in event.pose], "odom": [float(v) for v in event.odom],
                                "room": room, "room_type": self._room_types.get(room) if room else None,
                                "files": files}
-        stored = [port.store(values) for port in SENSORS]
+        stored = [port.encode(values) for port in SENSORS]
         contents = {kind: data for part in stored for kind, data in part.files.items()}
         if contents.keys() != files.keys():
             raise ValueError(f"the sensors stored files {sorted(contents)}, they declare {sorted(files)}")

@@ -418,7 +418,7 @@ class SimNode(Node):
         pubs, frame = self.agent_pubs[agent.name], self._frame(agent, port.frame)
         hdr = convert.header(stamp, frame)
         for topic in topics:
-            value = topic.value(data, agent.sensors[port.name], frame)
+            value = port.value(topic.key, data, agent.sensors[port.name], frame)
             pubs[topic.key].publish(convert.KINDS[topic.kind].to_message(value, hdr))
 
     def _note_reading(self, key: tuple[str, str], seconds: float) -> None:

@@ -23,8 +23,7 @@ import cv2
 import numpy as np
 
 from ravh_msgs_py import names
-from ravh_sim.dataset import layout
-from ravh_sim.files import atomic_write, write_image
+from ravh_sim.files import atomic_write, encode_png, read_png, write_image
 from ravh_sim.poses import quaternion_from_matrix
 from ravh_sim.render.renderers import make_renderer
 from ravh_sim.render.views import Renderer
@@ -43,6 +42,7 @@ from ravh_sim.sensors.readings import CameraInfo
 from ravh_sim.world.scene import World
 
 DISTORTION_MODEL = "plumb_bob"
+CAMERA_JSON = "camera.json"   # the dataset's side file: agent -> camera intrinsics
 NOISE_STREAM = 1            # noise generator stream of cameras (lasers use another)
 
 
@@ -229,56 +229,70 @@ def write_capture(camera: SmartCamera, capture: Capture, directory: Path) -> lis
 OPTICAL_ROTATION = quaternion_from_matrix(LINK_TO_OPTICAL)
 
 
-def _mounts(profile: RobotProfile) -> list[Mount]:
-    """camera_link on base_link from the same mount functions the camera renders with (TF and images
-    agree), and the optical frame on camera_link."""
-    cam = profile.camera
-    return [(names.BASE_FRAME, names.CAMERA_FRAME, tuple(mount_position(0.0, 0.0, 0.0, 0.0, cam.height, cam.forward)),
-             quaternion_from_matrix(mount_rotation(0.0, math.radians(cam.pitch_deg)))),
-            (names.CAMERA_FRAME, names.CAMERA_OPTICAL_FRAME, (0.0, 0.0, 0.0), OPTICAL_ROTATION)]
+class CameraPort(SensorPort[SmartCamera, Capture]):
+    """The camera: colour, depth and instance images with their camera info, rendered for captures and
+    stored as PNGs (colour, 16-bit mm depth, 16-bit instance ids); the intrinsics go to camera.json."""
+    name = "camera"
+    frame = names.CAMERA_OPTICAL_FRAME
+    captured = True
+    topics = (
+        Topic("rgb", names.COLOR_IMAGE, "rgb8", dataset=True, bag=False),
+        Topic("rgb_info", names.COLOR_INFO, "camera_info", dataset=True, bag=True),
+        Topic("jpeg", names.COLOR_COMPRESSED, "jpeg", dataset=False, bag=True),
+        Topic("depth", names.DEPTH_IMAGE, "32FC1", dataset=True, bag=True),
+        Topic("depth_info", names.DEPTH_INFO, "camera_info", dataset=False, bag=True),
+        Topic("instance", names.INSTANCE_IMAGE, "16UC1", dataset=True, bag=True),
+    )
+    files = {"rgb": ".png", "depth": ".png", "mask": ".png"}
+
+    def rate(self, profile: RobotProfile) -> float:
+        return profile.camera.rate
+
+    def mounts(self, profile: RobotProfile) -> list[Mount]:
+        """camera_link on base_link from the same mount functions the camera renders with (TF and images
+        agree), and the optical frame on camera_link."""
+        cam = profile.camera
+        return [(names.BASE_FRAME, names.CAMERA_FRAME,
+                 tuple(mount_position(0.0, 0.0, 0.0, 0.0, cam.height, cam.forward)),
+                 quaternion_from_matrix(mount_rotation(0.0, math.radians(cam.pitch_deg)))),
+                (names.CAMERA_FRAME, names.CAMERA_OPTICAL_FRAME, (0.0, 0.0, 0.0), OPTICAL_ROTATION)]
+
+    def build(self, world: World, profile: RobotProfile, agent: str) -> SmartCamera:
+        return SmartCamera(world, profile.camera, CameraOptions(**dict(profile.camera_effects)), agent,
+                           profile.camera_sensor)
+
+    def read(self, sensor: SmartCamera, robot: Robot) -> Capture:
+        x, y, yaw = robot.pose
+        return sensor.capture(x, y, yaw, velocity=robot.velocity)
+
+    def value(self, key: str, data: Capture, sensor: SmartCamera, frame: str) -> Any:
+        if key in ("rgb_info", "depth_info"):
+            return replace(data.camera_info, frame_id=frame)
+        if key == "jpeg":
+            return imaging.encode_jpeg(data.rgb, sensor.options.jpeg_quality)
+        if key == "instance":
+            return data.instance.astype(np.uint16)
+        return {"rgb": data.rgb, "depth": data.depth}[key]
+
+    def encode(self, values: Mapping[str, Any]) -> Stored:
+        rgb, depth, instance, info = values["rgb"], values["depth"], values["instance"], values["rgb_info"]
+        h, w = rgb.shape[:2]
+        if rgb.shape != (h, w, 3) or depth.shape != (h, w) or instance.shape != (h, w):
+            raise ValueError(f"image shapes differ: rgb {rgb.shape}, depth {depth.shape}, instance {instance.shape}")
+        if instance.size and (instance.min() < 0 or instance.max() > np.iinfo(np.uint16).max):
+            raise ValueError("instance ids must fit in 16 bits")
+        intrinsics = {"width": info.width, "height": info.height, "K": list(info.K), "D": list(info.D),
+                      "distortion_model": info.distortion_model, "frame_id": info.frame_id}
+        return Stored({"rgb": encode_png(np.ascontiguousarray(rgb, np.uint8)),
+                       "depth": encode_png(imaging.depth_to_png(depth)),
+                       "mask": encode_png(instance.astype(np.uint16))},
+                      agent_facts={CAMERA_JSON: intrinsics})
+
+    def decode(self, kind: str, path: Path, row: Mapping[str, Any]) -> np.ndarray:
+        """rgb: (H, W, 3) uint8 RGB; depth: (H, W) float32 metres along the optical axis, NaN = no
+        depth (1 mm steps); mask: (H, W) uint16 instance ids (footprint ids), 0 = nothing."""
+        pixels = read_png(path)
+        return imaging.depth_from_png(pixels) if kind == "depth" else pixels
 
 
-def _store(values: Mapping[str, Any]) -> Stored:
-    """PNGs of colour, depth (16-bit mm) and instances; the intrinsics go to camera.json."""
-    rgb, depth, instance, info = values["rgb"], values["depth"], values["instance"], values["rgb_info"]
-    h, w = rgb.shape[:2]
-    if rgb.shape != (h, w, 3) or depth.shape != (h, w) or instance.shape != (h, w):
-        raise ValueError(f"image shapes differ: rgb {rgb.shape}, depth {depth.shape}, instance {instance.shape}")
-    if instance.size and (instance.min() < 0 or instance.max() > np.iinfo(np.uint16).max):
-        raise ValueError("instance ids must fit in 16 bits")
-    intrinsics = {"width": info.width, "height": info.height, "K": list(info.K), "D": list(info.D),
-                  "distortion_model": info.distortion_model, "frame_id": info.frame_id}
-    return Stored({"rgb": layout.encode_png(np.ascontiguousarray(rgb, np.uint8)),
-                   "depth": layout.encode_png(imaging.depth_to_png(depth)),
-                   "mask": layout.encode_png(instance.astype(np.uint16))},
-                  agent_facts={layout.CAMERA_JSON: intrinsics})
-
-
-def _build(world: World, profile: RobotProfile, agent: str) -> SmartCamera:
-    return SmartCamera(world, profile.camera, CameraOptions(**dict(profile.camera_effects)), agent,
-                       profile.camera_sensor)
-
-
-def _read(camera: SmartCamera, robot: Robot) -> Capture:
-    x, y, yaw = robot.pose
-    return camera.capture(x, y, yaw, velocity=robot.velocity)
-
-
-def _info(capture: Capture, camera: SmartCamera, frame: str) -> CameraInfo:
-    return replace(capture.camera_info, frame_id=frame)
-
-
-PORT = SensorPort(
-    name="camera", frame=names.CAMERA_OPTICAL_FRAME, captured=True,
-    topics=(
-        Topic("rgb", names.COLOR_IMAGE, "rgb8", dataset=True, bag=False, value=lambda cap, cam, frame: cap.rgb),
-        Topic("rgb_info", names.COLOR_INFO, "camera_info", dataset=True, bag=True, value=_info),
-        Topic("jpeg", names.COLOR_COMPRESSED, "jpeg", dataset=False, bag=True,
-              value=lambda cap, cam, frame: imaging.encode_jpeg(cap.rgb, cam.options.jpeg_quality)),
-        Topic("depth", names.DEPTH_IMAGE, "32FC1", dataset=True, bag=True, value=lambda cap, cam, frame: cap.depth),
-        Topic("depth_info", names.DEPTH_INFO, "camera_info", dataset=False, bag=True, value=_info),
-        Topic("instance", names.INSTANCE_IMAGE, "16UC1", dataset=True, bag=True,
-              value=lambda cap, cam, frame: cap.instance.astype(np.uint16)),
-    ),
-    files={"rgb": ".png", "depth": ".png", "mask": ".png"}, rate=lambda profile: profile.camera.rate, mounts=_mounts,
-    build=_build, read=_read, store=_store)
+PORT = CameraPort()

@@ -12,14 +12,15 @@ sensor port (ravh_sim.sensors.ports).
 """
 from __future__ import annotations
 
+import io
 import math
 from collections.abc import Iterable, Mapping
-from typing import Any
+from pathlib import Path
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from ravh_msgs_py import names
-from ravh_sim.dataset import layout
 from ravh_sim.poses import quaternion_from_matrix
 from ravh_sim.robot.profile import LaserSpec, RobotProfile
 from ravh_sim.robot.robot import Robot
@@ -96,31 +97,64 @@ class Laser:
 
 # ---------------------------------------------------------------------------- the laser as a port
 
+class StoredScan(NamedTuple):
+    """One scan as a dataset stores it: angles (rad) and ranges (m) as published (inf/NaN kept)."""
+    angles: np.ndarray
+    ranges: np.ndarray
+    range_min: float
+    range_max: float
+
+
 def float32(value: float) -> float:
     """``value`` as a float32 field of LaserScan carries it, so a sample stores the same numbers
     whether it was read here or decoded from the topic."""
     return float(np.float32(value))
 
 
-def _mounts(profile: RobotProfile) -> list[Mount]:
-    return [(names.BASE_FRAME, names.LASER_FRAME, tuple(mount_position(0.0, 0.0, 0.0, 0.0, profile.laser.height)),
-             quaternion_from_matrix(mount_rotation(0.0)))]
+def encode_scan(ranges: np.ndarray, angle_min: float, angle_increment: float) -> bytes:
+    """.npy bytes of the (N, 2) float32 [angle, range] array stored per capture."""
+    ranges = np.asarray(ranges, np.float32).reshape(-1)
+    angles = angle_min + angle_increment * np.arange(len(ranges), dtype=np.float64)
+    buf = io.BytesIO()
+    np.save(buf, np.column_stack((angles.astype(np.float32), ranges)), allow_pickle=False)
+    return buf.getvalue()
 
 
-def _store(values: Mapping[str, Any]) -> Stored:
-    scan: Scan = values["scan"]
-    meta = {k: float32(getattr(scan, k)) for k in ("angle_min", "angle_increment", "range_min", "range_max")}
-    return Stored({"scan": layout.encode_scan(scan.ranges, meta["angle_min"], meta["angle_increment"])},
-                  row={"scan": meta})
+class LaserPort(SensorPort[Laser, Scan]):
+    """The laser: one scan topic, streamed and stored as a (N, 2) .npy with its limits in the row."""
+    name = "scan"
+    frame = names.LASER_FRAME
+    captured = False
+    topics = (Topic("scan", names.SCAN, "laser_scan", dataset=True, bag=True),)
+    files = {"scan": ".npy"}
+
+    def rate(self, profile: RobotProfile) -> float:
+        return profile.laser.rate
+
+    def mounts(self, profile: RobotProfile) -> list[Mount]:
+        return [(names.BASE_FRAME, names.LASER_FRAME,
+                 tuple(mount_position(0.0, 0.0, 0.0, 0.0, profile.laser.height)),
+                 quaternion_from_matrix(mount_rotation(0.0)))]
+
+    def build(self, world: World, profile: RobotProfile, agent: str) -> Laser:
+        return Laser(world, profile.laser, agent)
+
+    def read(self, sensor: Laser, robot: Robot) -> Scan:
+        x, y, yaw = robot.pose
+        return sensor.scan(x, y, yaw, ignore_bodies=(robot.body,))
+
+    def value(self, key: str, data: Scan, sensor: Laser, frame: str) -> Scan:
+        return data
+
+    def encode(self, values: Mapping[str, Any]) -> Stored:
+        scan: Scan = values["scan"]
+        meta = {k: float32(getattr(scan, k)) for k in ("angle_min", "angle_increment", "range_min", "range_max")}
+        return Stored({"scan": encode_scan(scan.ranges, meta["angle_min"], meta["angle_increment"])},
+                      row={"scan": meta})
+
+    def decode(self, kind: str, path: Path, row: Mapping[str, Any]) -> StoredScan:
+        data = np.load(path, allow_pickle=False)
+        return StoredScan(data[:, 0], data[:, 1], row["scan"]["range_min"], row["scan"]["range_max"])
 
 
-def _read(laser: Laser, robot: Robot) -> Scan:
-    x, y, yaw = robot.pose
-    return laser.scan(x, y, yaw, ignore_bodies=(robot.body,))
-
-
-PORT = SensorPort(
-    name="scan", frame=names.LASER_FRAME, captured=False,
-    topics=(Topic("scan", names.SCAN, "laser_scan", dataset=True, bag=True, value=lambda scan, laser, frame: scan),),
-    files={"scan": ".npy"}, rate=lambda profile: profile.laser.rate, mounts=_mounts,
-    build=lambda world, profile, agent: Laser(world, profile.laser, agent), read=_read, store=_store)
+PORT = LaserPort()

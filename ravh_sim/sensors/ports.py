@@ -2,19 +2,22 @@
 
 A :class:`SensorPort` says what a sensor is called, how often it runs (its rate, from the robot
 profile), where it sits (its mounts, for /tf_static), which topics it publishes and of what message
-kind, how to build and read it on an agent (ROS-free: the read returns the sensor's own data object)
-and how one sample of it is stored in a dataset. The runtime (which sensors are due), the sim node
-(publishers and publishing), the recorder (which parts make a capture) and the dataset writer all
-iterate over the suite (:data:`ravh_sim.sensors.suite.SENSORS`); the ROS side of each message kind
-lives in ``ravh_sim.nodes.convert.KINDS``. Adding a sensor: one module with the sensor and its port,
-one line in the suite.
+kind, how to build and read it on an agent (ROS-free: the read returns the sensor's own data object),
+what each topic carries, and how one sample of it is stored in a dataset and read back. The runtime
+(which sensors are due), the sim node (publishers and publishing), the recorder (which parts make a
+capture), the dataset writer and the dataset reader all iterate over the suite
+(:data:`ravh_sim.sensors.suite.SENSORS`); the ROS side of each message kind lives in
+``ravh_sim.nodes.convert.KINDS``. Adding a sensor: one module with the sensor and its port class, one
+line in the suite.
 """
 from __future__ import annotations
 
 import zlib
-from collections.abc import Callable, Mapping
+from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar, Generic, TypeVar
 
 import numpy as np
 
@@ -26,6 +29,9 @@ if TYPE_CHECKING:
 # (parent frame, child frame, xyz, quaternion xyzw) of a sensor mount, as on /tf_static
 Mount = tuple[str, str, tuple[float, ...], tuple[float, ...]]
 
+SensorT = TypeVar("SensorT")      # the sensor object an agent carries (Laser, SmartCamera)
+DataT = TypeVar("DataT")          # what one read of it returns (Scan, Capture)
+
 
 @dataclass(frozen=True)
 class Topic:
@@ -35,7 +41,6 @@ class Topic:
     kind: str                # message kind: a key of ravh_sim.nodes.convert.KINDS (type and conversions)
     dataset: bool            # part of a dataset sample (the recorder waits for it)
     bag: bool                # recorded in the bag
-    value: Callable[[Any, Any, str], Any]   # (data read, the sensor, frame id) -> the value published
 
 
 @dataclass(frozen=True)
@@ -46,19 +51,41 @@ class Stored:
     agent_facts: dict[str, Any] = field(default_factory=dict)  # side file (camera.json) -> this agent's entry
 
 
-@dataclass(frozen=True)
-class SensorPort:
+class SensorPort(ABC, Generic[SensorT, DataT]):
     """A kind of sensor, as the runtime, the nodes and the dataset see it."""
-    name: str                                        # rate key (profile, sim node overrides) and sensor key
-    frame: str                                       # the frame its data is stamped in (ravh_msgs_py.names)
-    captured: bool                                   # recorded only for requested captures (else streamed)
-    topics: tuple[Topic, ...]
-    files: dict[str, str]                            # its files in a dataset sample: kind (folder) -> extension
-    rate: Callable[[RobotProfile], float]            # Hz of sim time
-    mounts: Callable[[RobotProfile], list[Mount]]    # its frames on base_link (floor level)
-    build: Callable[[World, RobotProfile, str], Any]  # (world, profile, agent name) -> the sensor
-    read: Callable[[Any, Robot], Any]                # (sensor, robot) -> its data now
-    store: Callable[[Mapping[str, Any]], Stored]     # dataset values by topic key -> files and fields
+    name: ClassVar[str]                  # rate key (profile, sim node overrides) and sensor key
+    frame: ClassVar[str]                 # the frame its data is stamped in (ravh_msgs_py.names)
+    captured: ClassVar[bool]             # recorded only for requested captures (else streamed)
+    topics: ClassVar[tuple[Topic, ...]]
+    files: ClassVar[dict[str, str]]      # its files in a dataset sample: kind (folder) -> extension
+
+    @abstractmethod
+    def rate(self, profile: RobotProfile) -> float:
+        """Hz of sim time."""
+
+    @abstractmethod
+    def mounts(self, profile: RobotProfile) -> list[Mount]:
+        """Its frames on base_link (floor level)."""
+
+    @abstractmethod
+    def build(self, world: World, profile: RobotProfile, agent: str) -> SensorT:
+        """The sensor of agent ``agent``."""
+
+    @abstractmethod
+    def read(self, sensor: SensorT, robot: Robot) -> DataT:
+        """Its data now."""
+
+    @abstractmethod
+    def value(self, key: str, data: DataT, sensor: SensorT, frame: str) -> Any:
+        """What topic ``key`` publishes of ``data`` (stamped in ``frame``)."""
+
+    @abstractmethod
+    def encode(self, values: Mapping[str, Any]) -> Stored:
+        """Its files and fields of one dataset sample, from the dataset values by topic key."""
+
+    @abstractmethod
+    def decode(self, kind: str, path: Path, row: Mapping[str, Any]) -> Any:
+        """The data of its stored file of ``kind`` at ``path`` (``row``: the sample's captures.jsonl line)."""
 
 
 def noise_rng(seed: int, stream: int, agent: str, count: int) -> np.random.Generator:
