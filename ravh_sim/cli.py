@@ -212,7 +212,8 @@ def _sun_value(text: str) -> float | str:
 
 
 def cmd_raid(args: argparse.Namespace) -> int:
-    from ravh_sim.raids.raid import INTERRUPTED, run_raid
+    from ravh_sim.raids.outcome import Outcome
+    from ravh_sim.raids.raid import run_raid
     from ravh_sim.world.house import available_houses, load_house
     houses = available_houses() if args.all else [args.house]
     if not args.all:
@@ -222,10 +223,10 @@ def cmd_raid(args: argparse.Namespace) -> int:
         out = args.out / f"house{house:02d}_raid{args.raid}" if args.all else args.out
         results.append(run_raid(house, args.raid, out, fast=args.fast, seed=args.seed,
                                 max_captures=args.max_captures, max_nodes=args.max_nodes))
-        if results[-1]["status"].startswith(INTERRUPTED):       # Ctrl-C ends --all too
+        if Outcome.of(results[-1]["status"]) is Outcome.INTERRUPTED:       # Ctrl-C ends --all too
             break
     print(json.dumps(results if args.all else results[0], indent=1))
-    return 0 if all(r["status"] == "done" or r["status"].startswith("stopped") for r in results) else 1
+    return 0 if all(Outcome.of(r["status"]).complete for r in results) else 1
 
 
 def cmd_bench(args: argparse.Namespace) -> int:

@@ -17,6 +17,7 @@ from rosgraph import NodeProcess, ros_env
 from ravh_sim.dataset.api import Dataset
 from ravh_sim.errors import UserError
 from ravh_sim.nodes.common import SIM_LOST_S
+from ravh_sim.raids.outcome import Outcome
 from ravh_sim.raids.raid import PRESETS, _final_status, _rows, preset_settings, run_raid
 
 
@@ -127,6 +128,17 @@ class _Exited:
 ])
 def test_a_raid_is_done_only_when_nothing_was_lost(status, requested, recorded, behaviour, recorder, expected):
     assert _final_status(status, requested, recorded, _Exited(behaviour), _Exited(recorder)) == expected
+
+
+def test_every_status_sentence_reads_back_as_its_outcome():
+    details = {"captures": 5, "limit": "600 s", "name": "sim", "code": 2, "lost": 1, "requested": 3}
+    for outcome in Outcome:
+        assert Outcome.of(outcome.status(**details)) is outcome
+    assert Outcome.of("interrupted (Ctrl-C); lost 1 of 3 captures (see logs/)") is Outcome.INTERRUPTED
+    assert Outcome.of("timed out after 3600 sim s") is Outcome.TIMED_OUT                 # the direct engine's
+    assert [o for o in Outcome if o.complete] == [Outcome.DONE, Outcome.STOPPED]
+    with pytest.raises(ValueError, match="not a raid status"):
+        Outcome.of("finished")
 
 
 def test_behaviour_and_recorder_stop_when_the_sim_goes(tmp_path):

@@ -33,6 +33,7 @@ from ravh_sim import __version__
 from ravh_sim.dataset import layout
 from ravh_sim.errors import UserError
 from ravh_sim.paper import RAID_COLUMNS, TABLE2, table2
+from ravh_sim.raids.outcome import Outcome
 from ravh_sim.raids.raid import PRESETS, preset_settings, run_raid
 
 ENGINES = ("direct", "ros")
@@ -86,8 +87,10 @@ def finished(folder: Path) -> dict[str, Any] | None:
         summary = json.loads((folder / layout.RAID_JSON).read_text())
     except (OSError, ValueError):
         return None
-    status = str(summary.get("status", ""))
-    return summary if status == "done" or status.startswith("stopped at") else None
+    try:
+        return summary if Outcome.of(str(summary.get("status"))).complete else None
+    except ValueError:
+        return None
 
 
 def parameters(job: Job, options: BuildOptions) -> dict[str, Any]:

@@ -47,6 +47,7 @@ from ravh_sim.dataset.writer import DatasetWriter
 from ravh_sim.errors import UserError
 from ravh_sim.nav.follower import CONTROL_PERIOD, PathFollower
 from ravh_sim.poses import Pose2D
+from ravh_sim.raids.outcome import Outcome
 from ravh_sim.runtime import Agent, SimRuntime
 
 SETTINGS_FILE = "raid_settings.yaml"
@@ -165,19 +166,19 @@ class _Session:
                 self.agent.robot.teleport(*pose)
                 self.capture()
                 self.runtime.step(self.steps)
-            return "done"
+            return Outcome.DONE.status()
         behaviour = self._behaviour(spec)
         dt = self.steps * self.runtime.sim.dt
         end = self.runtime.time + max_sim_s
         while not behaviour.done:
             if self.runtime.time >= end:
-                return f"timed out after {max_sim_s:.0f} sim s"
+                return Outcome.TIMED_OUT.status(limit=f"{max_sim_s:.0f} sim s")
             for _ in behaviour.update(dt):
                 self.capture()
                 if max_captures and len(self.rows) >= max_captures:
-                    return f"stopped at {max_captures} captures"
+                    return Outcome.STOPPED.status(captures=max_captures)
             self.runtime.step(self.steps)
-        return "done"
+        return Outcome.DONE.status()
 
     def _behaviour(self, spec: GridSpec | WandererSpec) -> GridSweep | Wanderer:
         rt, robot = self.runtime, self.agent.robot

@@ -28,17 +28,18 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
+from tqdm import tqdm
 
 from ravh_sim.dataset import layout
 from ravh_sim.errors import UserError
 from ravh_sim.nodes.common import ros_domain_id
+from ravh_sim.raids.outcome import LOSS_SEPARATOR, Outcome
 from ravh_sim.world.settings import check_seed
 
 FAST_RTF = 4.0                   # --fast: sim seconds per wall second asked of the sim node
 POLL_S = 0.5
 RECORDER_START_S = 120.0         # the recorder is ready once the sim's footprint reached it
 DISCOVERY_S = 2.0
-INTERRUPTED = "interrupted (Ctrl-C)"
 HANDOVER_GRACE_S = 30.0          # wall seconds the recorder gets to store the behaviour's last captures
 
 
@@ -97,10 +98,12 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
     raid_meta = {"house": house, "raid": raid, "preset": preset.__dict__, "seed": seed, "fast": fast,
                  "ros_domain_id": domain, **(meta or {})}
     captures, given = out / layout.CAPTURES_JSONL, logs / "behaviour_captures.jsonl"
-    status = "done"
+    status = Outcome.DONE.status()
     sim = recorder = behaviour = None
     wind_down = ExitStack()
-    with wind_down:
+    progress = tqdm(total=max_captures or None, unit="capture", desc=f"house {house} raid {raid}",
+                    disable=quiet, file=sys.stderr, leave=True)
+    with wind_down, progress:
         try:
             sim = _spawn(["sim", "--house", str(house), "--config", str(settings_path), "--rtf", str(rtf),
                           "--camera-rate", "0", "--lockstep"], env, logs / "sim.log")
@@ -114,25 +117,23 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
                                env, logs / "behaviour.log")
             while behaviour.poll() is None:
                 rows = _rows(captures)
-                if not quiet:
-                    rooms = {r.get("room") for r in rows if r.get("room")}
-                    print(f"\r[house {house} raid {raid}] {len(rows)} captures, {len(rooms)} rooms, "
-                          f"{time.monotonic() - start:.0f} s", end="", file=sys.stderr, flush=True)
+                progress.update(len(rows) - progress.n)
+                progress.set_postfix(rooms=len({r.get("room") for r in rows if r.get("room")}), refresh=False)
                 stopped = [(name, proc) for name, proc in (("sim", sim), ("recorder", recorder))
                            if proc.poll() is not None]
                 if stopped:
                     name, proc = stopped[0]
-                    status = f"the {name} stopped with exit status {proc.returncode} (see logs/{name}.log)"
+                    status = Outcome.PROCESS_STOPPED.status(name=name, code=proc.returncode)
                     break
                 if max_captures and len(rows) >= max_captures:
-                    status = f"stopped at {max_captures} captures"
+                    status = Outcome.STOPPED.status(captures=max_captures)
                     break
                 if time.monotonic() - start > timeout:
-                    status = f"timed out after {timeout:.0f} s"
+                    status = Outcome.TIMED_OUT.status(limit=f"{timeout:.0f} s")
                     break
                 time.sleep(POLL_S)
         except KeyboardInterrupt:
-            status = INTERRUPTED
+            status = Outcome.INTERRUPTED.status()
         finally:
             wind_down.enter_context(_ctrl_c_ignored())       # a second Ctrl-C must not lose raid.json
             _stop(behaviour)
@@ -148,22 +149,21 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
                    "wall_s": round(time.monotonic() - start, 1),
                    "sim_s": round(rows[-1]["stamp"] - rows[0]["stamp"], 1) if len(rows) > 1 else 0.0}
         with _writing(out, f"; the raid ended: {status}"):
-            layout.atomic_write(out / "raid.json", (json.dumps(summary, indent=1) + "\n").encode())
-    if not quiet:
-        print(file=sys.stderr)
+            layout.atomic_write(out / layout.RAID_JSON, (json.dumps(summary, indent=1) + "\n").encode())
     return summary
 
 
 def _final_status(status: str, requested: int, recorded: int, behaviour: subprocess.Popen | None,
                   recorder: subprocess.Popen | None) -> str:
     """What the raid amounts to: losses first, then a process that failed, then how it ended."""
+    outcome = Outcome.of(status)
     if recorded < requested:
-        lost = f"lost {requested - recorded} of {requested} captures (see logs/)"
-        return f"{status}; {lost}" if status == INTERRUPTED else lost
-    if status == "done":
+        lost = Outcome.LOST.status(lost=requested - recorded, requested=requested)
+        return status + LOSS_SEPARATOR + lost if outcome is Outcome.INTERRUPTED else lost
+    if outcome is Outcome.DONE:
         for name, proc in (("behaviour", behaviour), ("recorder", recorder)):
             if proc is not None and proc.returncode not in (0, None):
-                return f"{name} exited with {proc.returncode} (see logs/{name}.log)"
+                return Outcome.PROCESS_FAILED.status(name=name, code=proc.returncode)
     return status
 
 
