@@ -84,8 +84,8 @@ class SimRuntime:
         self.agents = []
         for i, spec in enumerate(resolved.agents):
             profile = load_profile(spec.profile)
-            sensors = {port.name: port.build(self.world, profile, spec.name) for port in SENSORS}
-            own = {ODOM: profile.odom_rate, **{port.name: port.rate(profile) for port in SENSORS}}
+            sensors = {port.name: port.build(self.world, profile.spec(port), spec.name) for port in SENSORS}
+            own = {ODOM: profile.odom_rate, **{port.name: port.rate(profile.spec(port)) for port in SENSORS}}
             self.agents.append(Agent(spec.name, self.sim.robot(spec.name), profile, sensors,
                                      {**own, **(rates or {})}, i == 0))
         self.navigation = Navigation(self.house, self.world.state, self.agents[0].profile
@@ -162,7 +162,7 @@ class SimRuntime:
 
     def static_transforms(self, agent: Agent) -> list[Mount]:
         """(parent, child, xyz, quaternion xyzw) of every sensor mount on base_link (at floor level)."""
-        return [mount for port in SENSORS for mount in port.mounts(agent.profile)]
+        return [mount for port in SENSORS for mount in port.mounts(agent.profile.spec(port))]
 
     def room_of(self, agent: Agent) -> str | None:
         room = self.house.room_at(*agent.robot.pose[:2])

@@ -39,6 +39,14 @@ FINITE = AfterValidator(_finite)     # in Annotated[float, Field(...), FINITE], 
                                      # where a type checker must read the annotation
 
 
+# bounds of a robot profile (config/robots/*.yaml), its body and its sensors' sections: anything a real
+# mobile robot could have; beyond them a value is a slip (a 1e6 m radius, a 0.5 px camera)
+Length = Annotated[float, Field(gt=0.0, le=10.0), FINITE]           # m, body and mounting
+Rate = Annotated[float, Field(gt=0.0, le=1000.0), FINITE]           # Hz
+Sigma = Annotated[float, Field(ge=0.0, le=10.0), FINITE]
+Range = Annotated[float, Field(gt=0.0, le=1000.0), FINITE]          # m
+
+
 def number(ge: float | None = None, le: float | None = None, gt: float | None = None,
            lt: float | None = None) -> Any:
     """A finite float field with bounds; strict floats take ints (YAML/JSON write 1 for 1.0), not bools."""

@@ -128,9 +128,8 @@ LAYERS: list[tuple[str, ...]] = [
     ("ravh_msgs_py", "ravh_sim", "ravh_sim.errors", "ravh_sim.paths", "ravh_sim.files", "ravh_sim.poses",
      "ravh_sim.schema", "ravh_sim.paper"),
     ("ravh_sim.world", "ravh_sim.render"),      # the scene picks its render backend; renderers draw the scene
-    # a robot and what it carries: profiles hold the sensors' sections, sensors read their robot; a
-    # profile's body drives the planner, agents start on its free space
-    ("ravh_sim.robot", "ravh_sim.sensors", "ravh_sim.nav"),
+    ("ravh_sim.sensors",),                       # each declares its profile section, files and topics
+    ("ravh_sim.robot", "ravh_sim.nav"),          # a profile's body drives the planner; agents start on free space
     ("ravh_sim.dataset",),                       # the format: written and read through the sensor ports
     ("ravh_sim.viz",),                           # pictures of a house
     ("ravh_sim.behaviours",),

@@ -115,8 +115,8 @@ def test_frames_tone_mapped_by_the_renderer_give_back_their_radiance():
 
 
 def test_the_realistic_profile_has_the_sensor_and_the_ideal_one_does_not(tmp_path):
-    assert load_profile("giraff").camera_sensor == SensorModel(exposure_max=0.0333)
-    assert load_profile("giraff_ideal").camera_sensor is None
+    assert load_profile("giraff").camera.sensor == SensorModel(exposure_max=0.0333)
+    assert load_profile("giraff_ideal").camera.sensor is None
     bad = tmp_path / "bad.yaml"
     bad.write_text((ROBOTS_DIR / "giraff.yaml").read_text().replace("exposure_min: 0.0001", "exposure_min: 0.5"))
     with pytest.raises(FileFieldError, match="camera.sensor"):

@@ -40,7 +40,7 @@ def test_rates_come_from_the_robot_profile(runtime):
     agent = runtime.agents[0]
     assert agent.rates == {ODOM: agent.profile.odom_rate, "camera": agent.profile.camera.rate,
                            "scan": agent.profile.laser.rate}
-    assert all(port.rate(agent.profile) > 0 for port in SENSORS)
+    assert all(port.rate(agent.profile.spec(port)) > 0 for port in SENSORS)
 
 
 def test_rate_overrides_apply_on_top_and_unknown_rates_are_refused():

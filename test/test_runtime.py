@@ -187,11 +187,11 @@ def test_profile_camera_effects_are_validated(tmp_path):
     data["camera"]["effects"] = {"pixel_noise": 3.0, "distortion": [-0.1, 0.01, 0.0, 0.0, 0.0]}
     good = tmp_path / "noisy.yaml"
     good.write_text(yaml.safe_dump(data))
-    effects = dict(load_profile(good).camera_effects)
+    effects = dict(load_profile(good).camera.effects)
     assert effects["pixel_noise"] == 3.0 and effects["distortion"] == (-0.1, 0.01, 0.0, 0.0, 0.0)
     data["camera"]["effects"] = {"pixel_noise": None, "distortion": None}      # null: the camera's default
     good.write_text(yaml.safe_dump(data))
-    assert dict(load_profile(good).camera_effects) == {}
+    assert dict(load_profile(good).camera.effects) == {}
     data["camera"]["effects"] = {"distortion": [0.0, 0.0, 0.0, 0.0, 99.0]}
     good.write_text(yaml.safe_dump(data))
     with pytest.raises(FileFieldError, match="camera.effects.distortion"):

@@ -15,9 +15,9 @@ import yaml
 
 from ravh_sim.errors import FileFieldError, UserError
 from ravh_sim.paths import HOUSES_DIR, ROBOTS_DIR
-from ravh_sim.robot.profile import _Effects, load_profile
+from ravh_sim.robot.profile import load_profile
 from ravh_sim.schema import SHOWN_INPUT, field_path
-from ravh_sim.sensors.camera import CameraOptions
+from ravh_sim.sensors.camera import CameraEffects, CameraOptions
 from ravh_sim.world.house import load_house
 from ravh_sim.world.settings import SEED_MAX, load_settings, resolve
 
@@ -160,7 +160,7 @@ def test_non_utf8_profile(tmp_path):
 
 
 def test_profile_effects_schema_covers_camera_options():
-    assert set(_Effects.model_fields) == {f.name for f in dataclasses.fields(CameraOptions)}
+    assert set(CameraEffects.model_fields) == {f.name for f in dataclasses.fields(CameraOptions)}
 
 
 # ------------------------------------------------------------------ houses

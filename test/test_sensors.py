@@ -441,8 +441,8 @@ def test_the_robots_sensor_is_noisier_and_darker_at_night_and_the_ideal_camera_i
     the frame-to-frame noise of a still view grows as light falls, a night room with every light off
     stays dark (past the longest exposure and the highest gain); the ideal camera (no sensor) gives
     the same image twice."""
-    sensor = PROFILE.camera_sensor
-    assert sensor is not None and load_profile("giraff_ideal").camera_sensor is None
+    sensor = PROFILE.camera.sensor
+    assert sensor is not None and load_profile("giraff_ideal").camera.sensor is None
     real = SmartCamera(world, PROFILE.camera, agent="real", sensor=sensor)
     ideal = SmartCamera(world, PROFILE.camera, agent="ideal")
     noise, level = {}, {}

@@ -33,7 +33,7 @@ MIN_PIXELS = 50          # an instance with fewer pixels in an image does not co
 
 
 # file kind -> the sensor port that stores it (and so decodes it)
-PORT_OF_FILE: dict[str, SensorPort[Any, Any]] = {kind: port for port in SENSORS for kind in port.files}
+PORT_OF_FILE: dict[str, SensorPort[Any, Any, Any]] = {kind: port for port in SENSORS for kind in port.files}
 
 
 class Sample:

@@ -17,18 +17,19 @@ import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import cv2
 import numpy as np
+from pydantic import Field, model_validator
 
 from ravh_msgs_py import names
 from ravh_sim.files import atomic_write, encode_png, read_png, write_image
 from ravh_sim.poses import quaternion_from_matrix
+from ravh_sim.render.backend import QUALITIES
 from ravh_sim.render.renderers import make_renderer
 from ravh_sim.render.views import Renderer
-from ravh_sim.robot.profile import CameraSpec, RobotProfile
-from ravh_sim.robot.robot import Robot
+from ravh_sim.schema import FINITE, Length, Range, Rate, Strict
 from ravh_sim.sensors import imaging
 from ravh_sim.sensors.mount import (
     CAMERA_OPTICAL_FRAME,
@@ -37,13 +38,120 @@ from ravh_sim.sensors.mount import (
     mount_position,
     mount_rotation,
 )
-from ravh_sim.sensors.ports import Mount, SensorPort, Stored, Topic, noise_rng
+from ravh_sim.sensors.ports import Carrier, Mount, SensorPort, Stored, Topic, noise_rng
 from ravh_sim.sensors.readings import CameraInfo
-from ravh_sim.world.scene import World
+
+if TYPE_CHECKING:
+    from ravh_sim.world.scene import World
 
 DISTORTION_MODEL = "plumb_bob"
 CAMERA_JSON = "camera.json"   # the dataset's side file: agent -> camera intrinsics
 NOISE_STREAM = 1            # noise generator stream of cameras (lasers use another)
+MIN_NEAR = 0.001           # m, near plane: 1e-300 made the projection matrix singular
+Pixels = Annotated[int, Field(ge=16, le=8192)]
+Coefficient = Annotated[float, Field(ge=-10.0, le=10.0), FINITE]     # of lens distortion
+
+
+@dataclass(frozen=True)
+class CameraSpec:
+    height: float            # m above the floor
+    pitch_deg: float         # down
+    forward: float           # m ahead of the base centre
+    width: int               # px
+    height_px: int           # px
+    sensor_width: float      # mm
+    sensor_height: float     # mm
+    focal_length: float      # mm
+    near: float              # m
+    far: float               # m
+    rate: float              # Hz: frames published
+    quality: str = "realistic"   # realistic | fast (ravh_sim.render.backend.QUALITIES)
+    effects: tuple[tuple[str, Any], ...] = ()      # CameraOptions fields set by the profile
+    sensor: imaging.SensorModel | None = None      # None: the ideal camera (no sensor model)
+
+    @property
+    def fx(self) -> float:
+        """The paper's formula: fx = f * rx / sx."""
+        return self.focal_length * self.width / self.sensor_width
+
+    @property
+    def fy(self) -> float:
+        return self.focal_length * self.height_px / self.sensor_height
+
+    @property
+    def cx(self) -> float:
+        return self.width / 2.0
+
+    @property
+    def cy(self) -> float:
+        return self.height_px / 2.0
+
+
+class CameraEffects(Strict):
+    """The bounds of the realism effects the profile sets; their defaults live in CameraOptions
+    (an effect left out or null takes that default)."""
+    jpeg_quality: Annotated[int, Field(ge=1, le=100)] | None = None
+    jpeg_roundtrip: bool | None = None
+    pixel_noise: Annotated[float, Field(ge=0.0, le=255.0), FINITE] | None = None
+    distortion: Annotated[tuple[Coefficient, Coefficient, Coefficient, Coefficient, Coefficient],
+                          Field(strict=False)] | None = None
+    motion_blur: bool | None = None
+    exposure: Annotated[float, Field(gt=0.0, le=1.0), FINITE] | None = None
+    depth_noise: Annotated[float, Field(ge=0.0, le=1.0), FINITE] | None = None
+    manual_exposure: Annotated[float, Field(gt=0.0, le=100.0), FINITE] | None = None
+
+
+class CameraSensor(Strict):
+    """The camera sensor model (imaging.SensorModel); a field left out takes its default."""
+    enabled: bool = True
+    exposure_min: Annotated[float, Field(gt=0.0, le=1.0), FINITE] | None = None        # s
+    exposure_max: Annotated[float, Field(gt=0.0, le=1.0), FINITE] | None = None        # s
+    gain_max: Annotated[float, Field(ge=1.0, le=1000.0), FINITE] | None = None
+    full_well: Annotated[float, Field(gt=0.0, le=1e7), FINITE] | None = None           # e-
+    read_noise: Annotated[float, Field(ge=0.0, le=1000.0), FINITE] | None = None       # e- rms
+    sensitivity: Annotated[float, Field(gt=0.0, le=1e12), FINITE] | None = None       # e- / s / radiance
+    target: Annotated[float, Field(gt=0.0, le=1.0), FINITE] | None = None
+    adc_bits: Annotated[int, Field(ge=1, le=16)] | None = None
+    white_balance: bool | None = None
+    white_balance_limit: Annotated[float, Field(ge=1.0, le=100.0), FINITE] | None = None
+    reference_exposure: Annotated[float, Field(gt=0.0, le=100.0), FINITE] | None = None
+
+    @model_validator(mode="after")
+    def _ordered(self) -> CameraSensor:
+        model = self.model()
+        if model is not None and model.exposure_min > model.exposure_max:
+            raise ValueError(f"exposure_min {model.exposure_min} must not exceed exposure_max {model.exposure_max}")
+        return self
+
+    def model(self) -> imaging.SensorModel | None:
+        if not self.enabled:
+            return None
+        return imaging.SensorModel(**self.model_dump(exclude_none=True, exclude={"enabled"}))
+
+
+class CameraSection(Strict):
+    """The ``camera:`` section of a robot profile."""
+    height: Length
+    pitch: Annotated[float, Field(ge=-90.0, le=90.0), FINITE]
+    forward: Annotated[float, Field(ge=-10.0, le=10.0), FINITE]
+    width: Pixels
+    height_px: Pixels
+    sensor_width: Annotated[float, Field(gt=0.0, le=100.0), FINITE]     # mm
+    sensor_height: Annotated[float, Field(gt=0.0, le=100.0), FINITE]
+    focal_length: Annotated[float, Field(gt=0.0, le=1000.0), FINITE]
+    near: Annotated[float, Field(ge=MIN_NEAR, le=1000.0), FINITE]      # m
+    far: Range
+    rate: Rate
+    quality: Literal[QUALITIES] = "realistic"         # type: ignore[valid-type]
+    effects: CameraEffects = CameraEffects()
+    sensor: CameraSensor = CameraSensor(enabled=False)
+
+    @model_validator(mode="after")
+    def _ordered(self) -> CameraSection:
+        if self.near >= self.far:
+            raise ValueError(f"near {self.near} must be below far {self.far}")
+        return self
+
 
 
 @dataclass(frozen=True)
@@ -229,10 +337,12 @@ def write_capture(camera: SmartCamera, capture: Capture, directory: Path) -> lis
 OPTICAL_ROTATION = quaternion_from_matrix(LINK_TO_OPTICAL)
 
 
-class CameraPort(SensorPort[SmartCamera, Capture]):
+class CameraPort(SensorPort[CameraSpec, SmartCamera, Capture]):
     """The camera: colour, depth and instance images with their camera info, rendered for captures and
     stored as PNGs (colour, 16-bit mm depth, 16-bit instance ids); the intrinsics go to camera.json."""
     name = "camera"
+    section = "camera"
+    schema = CameraSection
     frame = names.CAMERA_OPTICAL_FRAME
     captured = True
     topics = (
@@ -245,25 +355,31 @@ class CameraPort(SensorPort[SmartCamera, Capture]):
     )
     files = {"rgb": ".png", "depth": ".png", "mask": ".png"}
 
-    def rate(self, profile: RobotProfile) -> float:
-        return profile.camera.rate
+    def spec(self, section: CameraSection) -> CameraSpec:
+        return CameraSpec(section.height, section.pitch, section.forward, section.width, section.height_px,
+                          section.sensor_width, section.sensor_height, section.focal_length, section.near,
+                          section.far, section.rate, section.quality,
+                          tuple(sorted(section.effects.model_dump(exclude_none=True).items())),
+                          section.sensor.model())
 
-    def mounts(self, profile: RobotProfile) -> list[Mount]:
+    def rate(self, spec: CameraSpec) -> float:
+        return spec.rate
+
+    def mounts(self, spec: CameraSpec) -> list[Mount]:
         """camera_link on base_link from the same mount functions the camera renders with (TF and images
         agree), and the optical frame on camera_link."""
-        cam = profile.camera
+        cam = spec
         return [(names.BASE_FRAME, names.CAMERA_FRAME,
                  tuple(mount_position(0.0, 0.0, 0.0, 0.0, cam.height, cam.forward)),
                  quaternion_from_matrix(mount_rotation(0.0, math.radians(cam.pitch_deg)))),
                 (names.CAMERA_FRAME, names.CAMERA_OPTICAL_FRAME, (0.0, 0.0, 0.0), OPTICAL_ROTATION)]
 
-    def build(self, world: World, profile: RobotProfile, agent: str) -> SmartCamera:
-        return SmartCamera(world, profile.camera, CameraOptions(**dict(profile.camera_effects)), agent,
-                           profile.camera_sensor)
+    def build(self, world: World, spec: CameraSpec, agent: str) -> SmartCamera:
+        return SmartCamera(world, spec, CameraOptions(**dict(spec.effects)), agent, spec.sensor)
 
-    def read(self, sensor: SmartCamera, robot: Robot) -> Capture:
-        x, y, yaw = robot.pose
-        return sensor.capture(x, y, yaw, velocity=robot.velocity)
+    def read(self, sensor: SmartCamera, carrier: Carrier) -> Capture:
+        x, y, yaw = carrier.pose
+        return sensor.capture(x, y, yaw, velocity=carrier.velocity)
 
     def value(self, key: str, data: Capture, sensor: SmartCamera, frame: str) -> Any:
         if key in ("rgb_info", "depth_info"):

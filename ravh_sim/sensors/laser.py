@@ -15,23 +15,69 @@ from __future__ import annotations
 import io
 import math
 from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Annotated, Any, NamedTuple
 
 import numpy as np
+from pydantic import Field, model_validator
 
 from ravh_msgs_py import names
 from ravh_sim.poses import quaternion_from_matrix
-from ravh_sim.robot.profile import LaserSpec, RobotProfile
-from ravh_sim.robot.robot import Robot
+from ravh_sim.schema import FINITE, Length, Range, Rate, Sigma, Strict
 from ravh_sim.sensors.mount import LASER_FRAME, floor_at, mount_position, mount_rotation
-from ravh_sim.sensors.ports import Mount, SensorPort, Stored, Topic, noise_rng
+from ravh_sim.sensors.ports import Carrier, Mount, SensorPort, Stored, Topic, noise_rng
 from ravh_sim.sensors.readings import Scan
-from ravh_sim.world.scene import World
+
+if TYPE_CHECKING:
+    from ravh_sim.world.scene import World
 
 NOISE_STREAM = 2            # noise generator stream of lasers (cameras use another)
+MAX_RAYS = 16384           # pybullet's rayTestBatch limit: more ends the sim with "Number of rays exceed..."
 STAGES = (1.5, 4.0, 10.0)   # m: ray lengths of the first cast stages (then range_max)
 STAGE_OVERLAP = 0.01        # m: a stage starts this much before the previous one ended
+
+
+@dataclass(frozen=True)
+class LaserSpec:
+    height: float            # m above the floor
+    fov_deg: float
+    resolution_deg: float
+    range_min: float
+    range_max: float
+    rate: float              # Hz: scans published (and LaserScan.scan_time)
+    noise_sigma: float       # m
+
+    @property
+    def ray_count(self) -> int:
+        """REP 117 / LaserScan counting: round((max - min) / increment) + 1 for a partial fan,
+        one ray per increment for a full circle (the last ray would repeat the first)."""
+        if self.fov_deg >= 360.0 - 1e-9:
+            return int(round(360.0 / self.resolution_deg))
+        return int(round(self.fov_deg / self.resolution_deg)) + 1
+
+
+class LaserSection(Strict):
+    """The ``laser:`` section of a robot profile."""
+    height: Length
+    fov: Annotated[float, Field(gt=0.0, le=360.0), FINITE]
+    resolution: Annotated[float, Field(ge=0.01, le=360.0), FINITE]
+    range_min: Range
+    range_max: Range
+    rate: Rate
+    noise_sigma: Sigma
+
+    @model_validator(mode="after")
+    def _ordered(self) -> LaserSection:
+        if self.range_min >= self.range_max:
+            raise ValueError(f"range_min {self.range_min} must be below range_max {self.range_max}")
+        if self.resolution > self.fov:
+            raise ValueError(f"resolution {self.resolution} is wider than fov {self.fov}")
+        if self.fov / self.resolution + 1 > MAX_RAYS:
+            raise ValueError(f"fov {self.fov} / resolution {self.resolution} makes more than {MAX_RAYS} rays "
+                             f"(what pybullet casts in one batch)")
+        return self
+
 
 
 class Laser:
@@ -120,28 +166,33 @@ def encode_scan(ranges: np.ndarray, angle_min: float, angle_increment: float) ->
     return buf.getvalue()
 
 
-class LaserPort(SensorPort[Laser, Scan]):
+class LaserPort(SensorPort[LaserSpec, Laser, Scan]):
     """The laser: one scan topic, streamed and stored as a (N, 2) .npy with its limits in the row."""
     name = "scan"
+    section = "laser"
+    schema = LaserSection
     frame = names.LASER_FRAME
     captured = False
     topics = (Topic("scan", names.SCAN, "laser_scan", dataset=True, bag=True),)
     files = {"scan": ".npy"}
 
-    def rate(self, profile: RobotProfile) -> float:
-        return profile.laser.rate
+    def spec(self, section: LaserSection) -> LaserSpec:
+        return LaserSpec(section.height, section.fov, section.resolution, section.range_min, section.range_max,
+                         section.rate, section.noise_sigma)
 
-    def mounts(self, profile: RobotProfile) -> list[Mount]:
-        return [(names.BASE_FRAME, names.LASER_FRAME,
-                 tuple(mount_position(0.0, 0.0, 0.0, 0.0, profile.laser.height)),
+    def rate(self, spec: LaserSpec) -> float:
+        return spec.rate
+
+    def mounts(self, spec: LaserSpec) -> list[Mount]:
+        return [(names.BASE_FRAME, names.LASER_FRAME, tuple(mount_position(0.0, 0.0, 0.0, 0.0, spec.height)),
                  quaternion_from_matrix(mount_rotation(0.0)))]
 
-    def build(self, world: World, profile: RobotProfile, agent: str) -> Laser:
-        return Laser(world, profile.laser, agent)
+    def build(self, world: World, spec: LaserSpec, agent: str) -> Laser:
+        return Laser(world, spec, agent)
 
-    def read(self, sensor: Laser, robot: Robot) -> Scan:
-        x, y, yaw = robot.pose
-        return sensor.scan(x, y, yaw, ignore_bodies=(robot.body,))
+    def read(self, sensor: Laser, carrier: Carrier) -> Scan:
+        x, y, yaw = carrier.pose
+        return sensor.scan(x, y, yaw, ignore_bodies=(carrier.body,))
 
     def value(self, key: str, data: Scan, sensor: Laser, frame: str) -> Scan:
         return data

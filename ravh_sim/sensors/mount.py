@@ -7,11 +7,14 @@ floor, possibly ahead of the base centre and pitched down. Frame names come from
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ravh_msgs_py.names import CAMERA_OPTICAL_FRAME, LASER_FRAME
-from ravh_sim.world.scene import World
+
+if TYPE_CHECKING:
+    from ravh_sim.world.scene import World
 
 __all__ = ["CAMERA_OPTICAL_FRAME", "LASER_FRAME", "LINK_TO_OPTICAL", "floor_at", "mount_position",
            "mount_rotation"]

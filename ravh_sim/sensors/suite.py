@@ -13,4 +13,4 @@ from ravh_sim.sensors.ports import SensorPort
 
 # Cheap sensors first: a scan due in the same tick as a camera frame is published before the render
 # (~50 ms on a CPU) instead of after it, as scans were before the suite existed (SLAM waits on them).
-SENSORS: tuple[SensorPort[Any, Any], ...] = (laser.PORT, camera.PORT)
+SENSORS: tuple[SensorPort[Any, Any, Any], ...] = (laser.PORT, camera.PORT)
