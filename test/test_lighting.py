@@ -45,9 +45,14 @@ def appearance(world):
     app.apply(before)
 
 
+def _camera_over(world: World) -> SmartCamera:
+    """A realistic camera with a fixed exposure (TopDown reads its renderer's linear light)."""
+    return SmartCamera(world, replace(PROFILE.camera, quality="realistic"), CameraOptions(manual_exposure=1.0))
+
+
 @pytest.fixture(scope="module")
 def camera(world):
-    camera = SmartCamera(world, replace(PROFILE.camera, quality="realistic"), CameraOptions(manual_exposure=1.0))
+    camera = _camera_over(world)
     yield camera
     camera.close()
 
@@ -182,10 +187,6 @@ def _open_the_door(appearance):
 
 def _swap_the_closet(appearance):
     appearance.set_object_model("Closet_0", 2)
-
-
-def _camera_over(world: World) -> SmartCamera:
-    return SmartCamera(world, replace(PROFILE.camera, quality="realistic"), CameraOptions(manual_exposure=1.0))
 
 
 @pytest.mark.parametrize("change, door_open, lit", [
