@@ -36,6 +36,7 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import shapely
@@ -44,6 +45,7 @@ from matplotlib import patheffects
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.font_manager import FontProperties
+from matplotlib.legend import Legend
 from matplotlib.legend_handler import HandlerTuple
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, FancyArrowPatch, Patch, PathPatch
@@ -498,7 +500,7 @@ class _Painter:
         for i in sorted(range(len(self.boxed)), key=lambda i: (-area(i), self.boxed[i].id)):
             self._object_label(i)
 
-    def _text(self, at: Sequence[float], text: str, size: float, colour: RGB, halo: RGB,
+    def _text(self, at: XY, text: str, size: float, colour: RGB, halo: RGB,
               rotation: float = 0, weight: str = "normal") -> None:
         self.ax.text(at[0], at[1], text, fontsize=size, color=rgb(colour), ha="center", va="center",
                      rotation=rotation, weight=weight, zorder=9, rotation_mode="anchor",
@@ -699,7 +701,7 @@ def _rect(a: np.ndarray, b: np.ndarray, thickness: float) -> np.ndarray:
     return np.array([a + n, b + n, b - n, a - n])
 
 
-def _box(centre: Sequence[float], size: Sequence[float]) -> shapely.Polygon:
+def _box(centre: XY, size: Sequence[float]) -> shapely.Polygon:
     """An axis-aligned rectangle of ``size`` (w, h) around ``centre``."""
     return shapely.box(centre[0] - size[0] / 2, centre[1] - size[1] / 2, centre[0] + size[0] / 2,
                        centre[1] + size[1] / 2)
@@ -795,9 +797,10 @@ def _marker(marker: str, size: float, fill: RGB | None, edge: RGB, width_px: flo
                   markerfacecolor=rgb(fill) if fill else "none", markeredgecolor=rgb(edge))
 
 
-def _section(figure: Figure, title: str, rows: Sequence[_Row], x: float, v: float):
+def _section(figure: Figure, title: str, rows: Sequence[_Row], x: float, v: float) -> Legend:
     """The legend of one section with its top-left corner at pixel (x, v), v counted from the top."""
-    handles, texts = [h for _, h in rows], [t for t, _ in rows]
+    handles: list[Any] = [h for _, h in rows]
+    texts = [t for t, _ in rows]
     legend = figure.legend(handles, texts, loc="upper left", bbox_to_anchor=(x, figure.bbox.height - v),
                            bbox_transform=IdentityTransform(), frameon=False, borderpad=0, borderaxespad=0,
                            handlelength=2.4, handletextpad=0.8, labelspacing=0.7, alignment="left",
