@@ -133,8 +133,6 @@ TITLE_BAND = 92      # px above the plan for the title
 PLAN_PAD_M = 0.25    # m added around house.bounds (wall thickness, windows)
 MAX_SIDE = 2400      # px; px_per_m is lowered so the image's long side stays within it
 WIDE_ASPECT = 2.0    # plans wider than this (w/h) get the legend below instead of beside
-
-
 PX = 72 / DPI        # points per pixel: matplotlib sizes lines and fonts in points
 
 
@@ -316,7 +314,7 @@ _LINE_GAP = 1.3                               # line pitch of a room label, time
 class _Painter:
     """Draws one house's layers onto a figure whose axes are the plan area, in world metres.
 
-    It also keeps, as shapely geometry, what labels must avoid: ``walls`` and ``symbols`` (doors,
+    It also keeps, as shapely geometry, what labels must avoid: ``walls_shape`` and ``symbols`` (doors,
     lights, the station), ``footprints`` (object boxes, and of each filled box the part no later
     box covers, ``visible``) and ``taken`` (labels already placed); small labels lie on ``floor``.
     """
@@ -327,9 +325,8 @@ class _Painter:
         self.ax: Axes = self.figure.add_axes((frame.left / frame.width,
                                               1 - (frame.top + frame.plan_h) / frame.height,
                                               frame.plan_w / frame.width, frame.plan_h / frame.height))
-        self.ax.set_xlim(frame.xmin, frame.xmin + frame.plan_w / frame.scale)
-        self.ax.set_ylim(frame.ymax - frame.plan_h / frame.scale, frame.ymax)
         self.ax.set_axis_off()
+        self._limits()
         self.renderer = self.figure.canvas.get_renderer()   # type: ignore[attr-defined]
         self.k = float(np.clip(frame.scale / 80, 0.75, 1.4))   # text size factor
         self.boxed = [o for o in house.objects if o.type not in SYMBOL_TYPES]
@@ -340,6 +337,11 @@ class _Painter:
         self.footprints: list[shapely.Polygon] = []
         self.visible: dict[int, shapely.Geometry] = {}
         self.taken: list[shapely.Polygon] = []
+
+    def _limits(self) -> None:
+        """The axes span exactly the frame's plan area, so world metres land on the frame's pixels."""
+        self.ax.set_xlim(self.f.xmin, self.f.xmin + self.f.plan_w / self.f.scale)
+        self.ax.set_ylim(self.f.ymax - self.f.plan_h / self.f.scale, self.f.ymax)
 
     def metres(self, px: float) -> float:
         return px / self.f.scale
@@ -375,8 +377,7 @@ class _Painter:
         tint[grid.data == FREE] = (*rgb(FREE_RGB), FREE_ALPHA)
         self.ax.imshow(tint, origin="lower", interpolation="nearest", zorder=2, aspect="auto",
                        extent=(ox, ox + cols * grid.resolution, oy, oy + rows * grid.resolution))
-        self.ax.set_xlim(self.f.xmin, self.f.xmin + self.f.plan_w / self.f.scale)   # imshow resets them
-        self.ax.set_ylim(self.f.ymax - self.f.plan_h / self.f.scale, self.f.ymax)
+        self._limits()                       # imshow widens the axes to the picture
 
     def objects(self) -> None:
         """Object boxes, lowest top first so what lies on top stays visible."""
