@@ -34,7 +34,9 @@ setup(
     package_data={"ravh_sim.render": ["shaders/*.glsl", "shaders/*.vert", "shaders/*.frag"],
                   "ravh_sim.eval": ["weights/*"]},
     install_requires=["numpy", "pybullet", "opencv-python-headless", "pyyaml", "pydantic>=2", "trimesh", "rosbags",
-                      "moderngl", "tqdm", "pycocotools"],
+                      "moderngl", "tqdm", "pycocotools",
+                      "matplotlib",     # the pictures: plans, raid summaries, the Table-4 heat map
+                      "shapely>=2"],    # floor outlines: areas, inside tests, label spots on plans
     extras_require={"ray": ["ray"],           # ravh dataset build --ray: raids as tasks on a Ray cluster
                     # the EfficientNet-Lite0 localization descriptor (its ONNX file ships in ravh_sim/eval/weights)
                     "cnn": ["onnxruntime"]},
