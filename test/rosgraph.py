@@ -96,20 +96,26 @@ def start_rclpy() -> None:
 
 
 def remove_orphan_shm(since: float) -> int:
-    """Delete Fast DDS shared-memory files made after ``since`` (epoch s) that no process maps any more:
-    what a SIGKILLed participant leaves behind. Returns how many were removed."""
+    """Delete Fast DDS shared-memory files made after ``since`` (epoch s) that no process holds any more:
+    what a SIGKILLed participant leaves behind. A segment is held where a process maps it; its lock
+    (``_el``, held open, never mapped) and its mutex (``sem.*_mutex``) go with it. Returns how many
+    were removed."""
     import glob
-    mapped: set[str] = set()
-    for maps in glob.glob("/proc/[0-9]*/maps"):
+    held: set[str] = set()
+    for pid in glob.glob("/proc/[0-9]*"):
         try:
-            with open(maps) as f:
-                mapped.update(line.split()[-1] for line in f if "/dev/shm/" in line)
+            with open(f"{pid}/maps") as f:
+                held.update(line.split()[-1] for line in f if "/dev/shm/" in line)
+            for fd in os.scandir(f"{pid}/fd"):
+                held.add(os.readlink(fd.path))
         except OSError:
             continue
     removed = 0
     for path in glob.glob("/dev/shm/*fastrtps_*"):
+        name = os.path.basename(path)
+        segment = "/dev/shm/" + name.removeprefix("sem.").removesuffix("_mutex").removesuffix("_el")
         try:
-            if os.path.getmtime(path) >= since and path not in mapped and path + "_el" not in mapped:
+            if os.path.getmtime(path) >= since and path not in held and segment not in held:
                 os.remove(path)
                 removed += 1
         except OSError:

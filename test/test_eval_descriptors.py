@@ -57,9 +57,13 @@ def test_inconsistent_or_non_finite_vectors_are_refused():
         describe([_scene(1)], lambda im: np.array([1.0, np.nan]))
 
 
+def test_the_shipped_cnn_reproduces_the_pytorch_network_it_was_exported_from():
+    from ravh_sim.eval.cnn_descriptor import REFERENCE, efficientnet_lite0
+    check = np.load(REFERENCE)                  # written by tools/export_cnn_onnx.py with torch's own pooling
+    assert np.abs(efficientnet_lite0(check["image"]) - check["descriptor"]).max() < 1e-5
+
+
 def test_the_cnn_descriptor_finds_each_view_again_in_dimmer_light(tmp_path_factory):
-    pytest.importorskip("torch")
-    pytest.importorskip("efficientnet_lite_pytorch")
     from ravh_sim.dataset.api import Dataset
     from ravh_sim.eval.cnn_descriptor import GRID, efficientnet_lite0
     views = [s.rgb for s in Dataset(small_dataset(tmp_path_factory))]      # 2 spots x 6 headings, house 20

@@ -11,7 +11,7 @@ from ravh_sim.dataset.api import Dataset
 from ravh_sim.errors import UserError
 from ravh_sim.eval.descriptors import describe, gradient_grid
 from ravh_sim.eval.localization import Localizer, errors, noisy_odometry
-from ravh_sim.eval.table4 import QUICK, RUNS, run_table4
+from ravh_sim.eval.table4 import QUICK, RUNS, draw_table4, run_table4
 
 
 @pytest.fixture(scope="module")
@@ -59,3 +59,16 @@ def test_recordings_are_reused_and_descriptors_plug_in(quick_run, capsys):
 def test_a_folder_of_other_recordings_is_refused(quick_run):
     with pytest.raises(UserError, match="other settings"):
         run_table4(20, quick_run, QUICK, seed=1)
+
+
+def test_heat_map_runs_from_dark_to_yellow_per_panel():
+    maps, routes = ["day 170", "night 200"], ["day 90", "night 185", "sunset 175"]
+    values = [[(0.3, 4.0), (1.8, 22.0)], [(2.4, 35.0), (0.5, 6.0)], [(0.9, 11.0), (1.2, 15.0)]]
+    doc = {"house": 15, "descriptor": "hog", "runs": 5, "maps": dict.fromkeys(maps, {}),
+           "cells": [[{"route": r, "map": m, "position_m": p, "rotation_deg": a} for m, (p, a) in zip(maps, row)]
+                     for r, row in zip(routes, values)]}
+    image = draw_table4(doc)
+    assert image.dtype == np.uint8 and image.shape[1] > image.shape[0]
+    top = (image == (36, 231, 253)).all(axis=2)          # viridis' top (BGR): the panel's largest value
+    half = image.shape[1] // 2
+    assert top[:, :half].sum() > 2000 and top[:, half:].sum() > 2000   # one whole cell in each panel

@@ -493,6 +493,12 @@ def test_read_map_reports_bad_files(tmp_path):
                    "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
     with pytest.raises(UserError, match="missing.pgm: -: cannot read"):
         read_map(bad)
+    for name, body in (("short.pgm", b"P5\n3 2\n255\n" + bytes(5)), ("wide.pgm", b"P5\n3 2\n65535\n" + bytes(12)),
+                       ("picture.pgm", b"\x89PNG\r\n")):
+        (tmp_path / name).write_bytes(body)
+        bad.write_text(f"image: {name}\nresolution: 0.05\norigin: [0, 0, 0]\n")
+        with pytest.raises(UserError, match=f"{name}: header: (not a greyscale PGM|expected 8-bit pixels)"):
+            read_map(bad)
 
 
 def test_unreachable_names_only_the_doors_that_cut_the_way(houses):

@@ -7,20 +7,18 @@ import json
 import time
 
 import pytest
+import rclpy
+from diagnostic_msgs.srv import AddDiagnostics
+from rclpy.qos import QoSProfile
 from rosgraph import NodeProcess, spin_until, start_rclpy
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import Image
 
-rclpy = pytest.importorskip("rclpy")
-
-from diagnostic_msgs.srv import AddDiagnostics  # noqa: E402
-from rclpy.qos import QoSProfile  # noqa: E402
-from rosgraph_msgs.msg import Clock  # noqa: E402
-from sensor_msgs.msg import Image  # noqa: E402
-
-from ravh_msgs_py import names as n  # noqa: E402
-from ravh_msgs_py.client import RavhClient  # noqa: E402
-from ravh_msgs_py.query import BUSY  # noqa: E402
-from ravh_sim.nodes.common import SENSOR_QOS, STATE_QOS  # noqa: E402
-from ravh_sim.nodes.sim_node import WorkBudget  # noqa: E402
+from ravh_msgs_py import names as n
+from ravh_msgs_py.client import RavhClient
+from ravh_msgs_py.query import BUSY
+from ravh_sim.nodes.common import SENSOR_QOS, STATE_QOS
+from ravh_sim.nodes.sim_node import WorkBudget
 
 BURST_HZ = 50.0
 BURST_S = 8.0

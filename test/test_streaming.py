@@ -10,20 +10,18 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph import start_rclpy
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import Image, LaserScan
+from std_srvs.srv import Trigger
 
-rclpy = pytest.importorskip("rclpy")
-
-from rclpy.executors import SingleThreadedExecutor  # noqa: E402
-from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
-from rosgraph_msgs.msg import Clock  # noqa: E402
-from sensor_msgs.msg import Image, LaserScan  # noqa: E402
-from std_srvs.srv import Trigger  # noqa: E402
-
-from ravh_msgs_py import names as n  # noqa: E402
-from ravh_sim.nodes import convert  # noqa: E402
-from ravh_sim.render.views import RenderedViews  # noqa: E402
-from ravh_sim.sensors import imaging  # noqa: E402
+from ravh_msgs_py import names as n
+from ravh_sim.nodes import convert
+from ravh_sim.render.views import RenderedViews
+from ravh_sim.sensors import imaging
 
 # deep enough that the test, spinning the node in its own thread, loses nothing
 KEEP_ALL = QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE)

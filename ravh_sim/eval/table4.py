@@ -32,6 +32,7 @@ from ravh_sim.errors import UserError
 from ravh_sim.eval.descriptors import Descriptor, describe, load_descriptor
 from ravh_sim.eval.localization import Localizer, errors, noisy_odometry
 from ravh_sim.raids.direct import MAX_SIM_S, GridSpec, PosesSpec, WandererSpec, record
+from ravh_sim.viz.figure import figure_bgr, new_figure
 
 RUNS = 5
 SPEED = 0.25                       # m/s, the Wanderer's cruise speed (the giraff profile's maximum)
@@ -185,44 +186,31 @@ def format_table4(doc: dict[str, Any]) -> str:
 
 # --------------------------------------------------------------------------- the heat map
 
-CELL_W, CELL_H, LABEL_W, HEAD_H, GAP = 120, 44, 120, 70, 40
-FONT = cv2.FONT_HERSHEY_SIMPLEX
+CELL_W, CELL_H = 120, 44          # px per table cell
+MARGIN_W, MARGIN_H = 300, 150     # px around the cells: route names, map names, titles, colour bars
 
 
 def draw_table4(doc: dict[str, Any]) -> np.ndarray:
-    """Two heat maps side by side, position and rotation error, routes x maps (BGR)."""
-    panels = [_panel(doc, "position_m", "position error (m)", "{:.2f}"),
-              _panel(doc, "rotation_deg", "rotation error (deg)", "{:.1f}")]
-    height = max(p.shape[0] for p in panels)
-    panels = [np.vstack([p, np.full((height - p.shape[0], p.shape[1], 3), 255, np.uint8)]) for p in panels]
-    body = np.hstack([panels[0], np.full((height, GAP, 3), 255, np.uint8), panels[1]])
-    text = (f"House {doc['house']} localization ({doc['descriptor']}), median of {doc['runs']} runs; "
-            "colour from 0 (dark) to the largest value (yellow)")
-    width = max(body.shape[1], cv2.getTextSize(text, FONT, 0.55, 1)[0][0] + 24)
-    title = np.full((40, width, 3), 255, np.uint8)
-    cv2.putText(title, text, (12, 28), FONT, 0.55, (40, 40, 40), 1, cv2.LINE_AA)
-    return np.vstack([title, np.hstack([body, np.full((height, width - body.shape[1], 3), 255, np.uint8)])])
-
-
-def _panel(doc: dict[str, Any], key: str, heading: str, fmt: str) -> np.ndarray:
-    rows, maps = doc["cells"], list(doc["maps"])
-    values = np.array([[c[key] for c in row] for row in rows], float)
-    heading_w = cv2.getTextSize(heading, FONT, 0.6, 1)[0][0]
-    width = LABEL_W + max(CELL_W * len(maps), heading_w) + 10
-    img = np.full((HEAD_H + CELL_H * len(rows) + 10, width, 3), 255, np.uint8)
-    cv2.putText(img, heading, (LABEL_W, 22), FONT, 0.6, (40, 40, 40), 1, cv2.LINE_AA)
-    top = values.max() if values.size and values.max() > 0 else 1.0
-    colours = cv2.applyColorMap(np.uint8(np.clip(values / top, 0, 1) * 255).reshape(-1, 1), cv2.COLORMAP_VIRIDIS)
-    for j, m in enumerate(maps):
-        cv2.putText(img, f"map {m}", (LABEL_W + j * CELL_W + 6, HEAD_H - 12), FONT, 0.45, (40, 40, 40), 1,
-                    cv2.LINE_AA)
-    for i, row in enumerate(rows):
-        y = HEAD_H + i * CELL_H
-        cv2.putText(img, row[0]["route"], (6, y + CELL_H // 2 + 5), FONT, 0.5, (40, 40, 40), 1, cv2.LINE_AA)
-        for j in range(len(maps)):
-            x = LABEL_W + j * CELL_W
-            colour = tuple(int(c) for c in colours[i * len(maps) + j, 0])
-            cv2.rectangle(img, (x, y), (x + CELL_W - 2, y + CELL_H - 2), colour, -1)
-            ink = (0, 0, 0) if values[i, j] / top > 0.6 else (255, 255, 255)
-            cv2.putText(img, fmt.format(values[i, j]), (x + 30, y + CELL_H // 2 + 6), FONT, 0.55, ink, 1, cv2.LINE_AA)
-    return img
+    """Two heat maps side by side, position and rotation error, routes x maps (BGR); each colour
+    scale runs from 0 to the panel's largest value."""
+    routes, maps = [row[0]["route"] for row in doc["cells"]], list(doc["maps"])
+    figure = new_figure(2 * (MARGIN_W + CELL_W * len(maps)), MARGIN_H + CELL_H * len(routes))
+    figure.suptitle(f"House {doc['house']} localization ({doc['descriptor']}), median of {doc['runs']} runs",
+                    fontsize=12)
+    panels = figure.subplots(1, 2, gridspec_kw={"left": 0.1, "right": 0.95, "wspace": 0.6,
+                                                "top": 1 - 70 / figure.bbox.height, "bottom": 0.06})
+    for axes, (key, heading, fmt) in zip(panels, (("position_m", "position error (m)", "{:.2f}"),
+                                                  ("rotation_deg", "rotation error (deg)", "{:.1f}"))):
+        values = np.array([[c[key] for c in row] for row in doc["cells"]], float)
+        top = values.max() if values.size and values.max() > 0 else 1.0
+        image = axes.imshow(values, cmap="viridis", vmin=0.0, vmax=top, aspect="auto")
+        axes.set_title(heading, fontsize=11, pad=24)
+        axes.set_xticks(range(len(maps)), [f"map {m}" for m in maps], fontsize=9)
+        axes.set_yticks(range(len(routes)), routes, fontsize=9)
+        axes.xaxis.tick_top()
+        axes.tick_params(length=0)
+        for i, j in np.ndindex(values.shape):
+            axes.text(j, i, fmt.format(values[i, j]), ha="center", va="center", fontsize=11,
+                      color="black" if values[i, j] / top > 0.6 else "white")
+        figure.colorbar(image, ax=axes, fraction=0.08, pad=0.03)
+    return figure_bgr(figure)

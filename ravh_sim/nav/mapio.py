@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import cv2
 import numpy as np
 import yaml
 
@@ -93,32 +94,14 @@ def _number(meta: dict, key: str, path: Path) -> float:
 
 
 def _read_pgm(path: Path) -> np.ndarray:
-    """The pixels of an 8-bit binary (P5) PGM, top row first."""
+    """The pixels of an 8-bit greyscale PGM, top row first."""
     try:
         raw = path.read_bytes()
     except OSError as e:
         raise FileFieldError(path, "-", f"cannot read: {e.strerror}") from None
-    fields: list[bytes] = []
-    pos = 0
-    while len(fields) < 4:                                 # magic, width, height, maxval
-        while pos < len(raw) and raw[pos:pos + 1].isspace():
-            pos += 1
-        if raw[pos:pos + 1] == b"#":
-            pos = raw.find(b"\n", pos) + 1 or len(raw)
-            continue
-        end = pos
-        while end < len(raw) and not raw[end:end + 1].isspace():
-            end += 1
-        if end == pos:
-            break
-        fields.append(raw[pos:end])
-        pos = end
-    if len(fields) < 4 or fields[0] != b"P5" or not all(f.isdigit() for f in fields[1:]):
-        raise FileFieldError(path, "header", "not an 8-bit binary PGM (P5)")
-    cols, rows, maxval = (int(f) for f in fields[1:])
-    if maxval != 255:
-        raise FileFieldError(path, "header", f"expected maxval 255, got {maxval}")
-    body = raw[pos + 1:pos + 1 + rows * cols]              # one whitespace byte ends the header
-    if len(body) != rows * cols:
-        raise FileFieldError(path, "data", f"expected {rows * cols} pixels, got {len(body)}")
-    return np.frombuffer(body, np.uint8).reshape(rows, cols)
+    pixels = cv2.imdecode(np.frombuffer(raw, np.uint8), cv2.IMREAD_UNCHANGED) if raw[:2] in (b"P2", b"P5") else None
+    if pixels is None or pixels.ndim != 2:
+        raise FileFieldError(path, "header", "not a greyscale PGM, or its pixels are cut short")
+    if pixels.dtype != np.uint8:
+        raise FileFieldError(path, "header", f"expected 8-bit pixels (maxval 255), got {pixels.dtype}")
+    return pixels

@@ -16,6 +16,7 @@ import numpy as np
 from ravh_sim.raids.raid import PRESETS, preset_settings
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.sensors.camera import SmartCamera
+from ravh_sim.viz.figure import figure_bgr, new_figure
 from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import load_house
@@ -92,9 +93,11 @@ def _preset(house, raid: int, seed: int) -> Resolved:
 
 
 def _labelled(rgb: np.ndarray, text: str) -> np.ndarray:
-    strip = np.full((LABEL_PX, rgb.shape[1], 3), 24, np.uint8)
-    cv2.putText(strip, text, (8, LABEL_PX - 10), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (235, 235, 235), 1, cv2.LINE_AA)
-    return np.vstack([rgb, strip])
+    """The RGB picture above a dark strip that names it."""
+    strip = new_figure(rgb.shape[1], LABEL_PX)
+    strip.set_facecolor((24 / 255,) * 3)
+    strip.text(8 / rgb.shape[1], 0.5, text, color=(235 / 255,) * 3, fontsize=10, va="center")
+    return np.vstack([rgb, cv2.cvtColor(figure_bgr(strip), cv2.COLOR_BGR2RGB)])
 
 
 SHOWCASE_TYPES = ("Sofa", "Armchair", "Bed", "Table", "Chair", "Refrigerator", "Oven", "Toilet", "Tv",

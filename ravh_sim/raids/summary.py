@@ -3,7 +3,8 @@
 One picture answers "where did the robot go and what did it see": the plan (rooms, furniture, doors
 as recorded) with the capture poses joined in order, and sample captures spread over the raid, each
 as RGB, colourised depth and the instance mask, headed by its room. Every sheet tile has a numbered
-marker on the plan at the pose it was taken from, so picture and place can be matched.
+marker on the plan at the pose it was taken from, so picture and place can be matched. The picture
+is one matplotlib figure: the plan and the captures are placed in it pixel for pixel.
 """
 from __future__ import annotations
 
@@ -11,9 +12,17 @@ from collections import Counter
 from pathlib import Path
 
 import cv2
+import matplotlib
 import numpy as np
+from matplotlib.colorbar import Colorbar
+from matplotlib.colors import Normalize
+from matplotlib.figure import Figure
+from matplotlib.font_manager import FontProperties
+from matplotlib.patches import Circle, Rectangle
+from matplotlib.transforms import IdentityTransform
 
 from ravh_sim.dataset.api import Dataset, Sample
+from ravh_sim.viz.figure import figure_bgr, new_figure, rgb
 from ravh_sim.viz.plan import Plan, render_plan, room_color, write_plan
 
 COLS, ROWS = 4, 3                      # contact sheet tiles
@@ -22,24 +31,36 @@ HEAD_H = 46                            # tile header band: number, room, capture
 GAP = 14
 SHEET_HEAD = 64                        # band above the tiles: the sheet's title and the depth scale
 DEPTH_RANGE_M = (0.0, 8.0)             # colour scale of the depth tiles (turbo, black = no depth)
+DEPTH_MAP = matplotlib.colormaps["turbo"]
 MAX_POSES = 150                        # capture arrows drawn on the plan at most (every k-th beyond)
 PLAN_PX_PER_M = (40.0, 160.0)          # the plan is scaled to fit the sheet within these bounds
 WIDE = 1.25                            # a plan this much wider than tall goes above the sheet
-FONT, BOLD, AA = cv2.FONT_HERSHEY_SIMPLEX, cv2.FONT_HERSHEY_DUPLEX, cv2.LINE_AA
-INK, SUBINK, PAPER = (44, 40, 40), (104, 96, 96), (255, 255, 255)     # BGR
-MARKER_BGR = (40, 40, 200)
+INK, SUBINK = (40, 40, 44), (96, 96, 104)                            # RGB
+MARKER_RGB = (200, 40, 40)
+NUMBER_PT, TEXT_PT, SMALL_PT = 10.0, 9.5, 7.5                       # font sizes
+TILE_H_ALL = HEAD_H + TILE_H + TILE_H // 2
+SHEET_W = COLS * TILE_W + (COLS + 1) * GAP
+SHEET_H = SHEET_HEAD + ROWS * TILE_H_ALL + (ROWS + 1) * GAP
 
 
 def render_summary(dataset: Dataset) -> np.ndarray:
     """The summary picture (BGR uint8) of ``dataset``."""
     picks = pick_samples(dataset, COLS * ROWS)
-    sheet = _contact_sheet(dataset, picks)
-    plan, beside = _plan(dataset, picks, sheet.shape[:2])
+    plan, beside = _plan(dataset, (SHEET_H, SHEET_W))
+    plan_h, plan_w = plan.image.shape[:2]
     if beside:
-        height = max(plan.shape[0], sheet.shape[0])
-        return np.hstack([_pad(plan, height, 0), _pad(sheet, height, 0)])
-    width = max(plan.shape[1], sheet.shape[1])
-    return np.vstack([_pad(plan, width, 1), _pad(sheet, width, 1)])
+        width, height = plan_w + SHEET_W, max(plan_h, SHEET_H)
+        plan_at, sheet_at = (0, 0), (plan_w, 0)
+    else:
+        width, height = max(plan_w, SHEET_W), plan_h + SHEET_H
+        plan_at, sheet_at = ((width - plan_w) // 2, 0), ((width - SHEET_W) // 2, plan_h)
+    figure = new_figure(width, height)
+    _image(figure, cv2.cvtColor(plan.image, cv2.COLOR_BGR2RGB), *plan_at)
+    for number, sample in enumerate(picks, start=1):
+        u, v = plan.frame.to_px(sample.pose[0], sample.pose[1])
+        _marker(figure, plan_at[0] + u, plan_at[1] + v, number)
+    _contact_sheet(figure, dataset, picks, *sheet_at)
+    return figure_bgr(figure)
 
 
 def write_summary(dataset: Dataset, path: str | Path) -> None:
@@ -56,10 +77,9 @@ def pick_samples(dataset: Dataset, count: int) -> list[Sample]:
 
 # --------------------------------------------------------------------------- the plan
 
-def _plan(dataset: Dataset, picks: list[Sample], sheet_hw: tuple[int, int]) -> tuple[np.ndarray, bool]:
-    """The house plan with the trajectory, capture arrows and the picks' numbered markers, and
-    whether it goes beside the sheet (scaled to its height) or, for a wide plan, above it (scaled
-    to its width)."""
+def _plan(dataset: Dataset, sheet_hw: tuple[int, int]) -> tuple[Plan, bool]:
+    """The house plan with the trajectory and capture arrows, and whether it goes beside the sheet
+    (scaled to its height) or, for a wide plan, above it (scaled to its width)."""
     house, settings = dataset.house, dataset.settings
     samples = list(dataset)
     first = samples[0].agent if samples else None
@@ -81,108 +101,116 @@ def _plan(dataset: Dataset, picks: list[Sample], sheet_hw: tuple[int, int]) -> t
     scale = float(np.clip(80.0 * ratio, *PLAN_PX_PER_M))
     if abs(scale - 80.0) > 4.0:
         plan = draw(scale)
-    image = plan.image
-    for number, sample in enumerate(picks, start=1):
-        u, v = plan.frame.to_px(sample.pose[0], sample.pose[1])
-        _marker(image, (int(round(u)), int(round(v))), number)
-    return image, beside
+    return plan, beside
 
 
-def _marker(img: np.ndarray, centre: tuple[int, int], number: int) -> None:
-    """A red disc with a white number, offset up-right of the pose with a leader line."""
-    text = str(number)
-    (w, h), _ = cv2.getTextSize(text, BOLD, 0.55, 1)
-    r = max(w, h) // 2 + 6
-    at = (centre[0] + r + 6, centre[1] - r - 6)
-    cv2.line(img, centre, at, MARKER_BGR, 2, AA)
-    cv2.circle(img, at, r + 2, PAPER, -1, AA)
-    cv2.circle(img, at, r, MARKER_BGR, -1, AA)
-    cv2.putText(img, text, (at[0] - w // 2, at[1] + h // 2), BOLD, 0.55, PAPER, 1, AA)
+def _marker(figure: Figure, u: float, v: float, number: int) -> None:
+    """A red disc with a white number, offset up-right of the pose (pixel u, v) with a leader line."""
+    r = 13.0
+    at = (u + r + 6, v - r - 6)
+    figure.add_artist(matplotlib.lines.Line2D([u, at[0]], [_y(figure, v), _y(figure, at[1])], linewidth=1.5,
+                                              color=rgb(MARKER_RGB), transform=IdentityTransform()))
+    _disc(figure, at[0], at[1], r, str(number), ring=True)
+
+
+def _disc(figure: Figure, u: float, v: float, r: float, text: str, ring: bool = False) -> None:
+    figure.add_artist(Circle((u, _y(figure, v)), r, facecolor=rgb(MARKER_RGB), transform=IdentityTransform(),
+                             edgecolor="white" if ring else "none", linewidth=1.5))
+    figure.text(u, _y(figure, v), text, fontsize=NUMBER_PT, weight="bold", color="white", ha="center",
+                va="center_baseline", transform=IdentityTransform())
 
 
 # --------------------------------------------------------------------------- the contact sheet
 
-def _contact_sheet(dataset: Dataset, picks: list[Sample]) -> np.ndarray:
-    tile_h = HEAD_H + TILE_H + TILE_H // 2
-    width = COLS * TILE_W + (COLS + 1) * GAP
-    height = SHEET_HEAD + ROWS * tile_h + (ROWS + 1) * GAP
-    sheet = np.full((height, width, 3), PAPER, np.uint8)
-    cv2.putText(sheet, f"{len(picks)} of {len(dataset)} captures: RGB, depth, instances", (GAP, 36),
-                BOLD, 0.8, INK, 1, AA)
-    _depth_scale(sheet, (width - GAP - 300, 22))
+def _contact_sheet(figure: Figure, dataset: Dataset, picks: list[Sample], x0: int, y0: int) -> None:
+    """The sheet with its top-left corner at pixel (x0, y0)."""
+    _text(figure, x0 + GAP, y0 + 36, f"{len(picks)} of {len(dataset)} captures: RGB, depth, instances", 15,
+          INK, weight="bold")
+    _depth_scale(figure, x0 + SHEET_W - GAP - 250, y0 + 22)
     if not picks:
-        cv2.putText(sheet, "no complete captures", (GAP, SHEET_HEAD + 60), FONT, 0.8, SUBINK, 1, AA)
+        _text(figure, x0 + GAP, y0 + SHEET_HEAD + 60, "no complete captures", 14, SUBINK)
     for number, sample in enumerate(picks, start=1):
         row, col = divmod(number - 1, COLS)
-        x, y = GAP + col * (TILE_W + GAP), SHEET_HEAD + GAP + row * (tile_h + GAP)
-        sheet[y:y + tile_h, x:x + TILE_W] = _tile(sample, number, dataset.objects_in(sample))
-    return sheet
+        x, y = x0 + GAP + col * (TILE_W + GAP), y0 + SHEET_HEAD + GAP + row * (TILE_H_ALL + GAP)
+        _tile(figure, sample, number, dataset.objects_in(sample), x, y)
 
 
-def _tile(sample: Sample, number: int, seen: Counter[str]) -> np.ndarray:
+def _tile(figure: Figure, sample: Sample, number: int, seen: Counter[str], x: int, y: int) -> None:
     """Header (number, room on its plan colour, capture, objects in view), RGB, then depth | mask
-    at half size."""
+    at half size, with the top-left corner at pixel (x, y)."""
     half = (TILE_W // 2, TILE_H // 2)
-    tile = np.full((HEAD_H + TILE_H + half[1], TILE_W, 3), PAPER, np.uint8)
-    swatch = room_color(sample.room_type or "")
-    tile[:HEAD_H] = swatch[::-1]
-    centre = (18, HEAD_H // 2)
-    cv2.circle(tile, centre, 13, MARKER_BGR, -1, AA)
-    (w, h), _ = cv2.getTextSize(str(number), BOLD, 0.55, 1)
-    cv2.putText(tile, str(number), (centre[0] - w // 2, centre[1] + h // 2), BOLD, 0.55, PAPER, 1, AA)
+    _box(figure, x, y, TILE_W, HEAD_H, fill=room_color(sample.room_type or ""))
+    _disc(figure, x + 18, y + HEAD_H / 2, 13, str(number))
     when = f"#{sample.index}  {sample.stamp:.1f} s"
-    when_w = cv2.getTextSize(when, FONT, 0.42, 1)[0][0]
-    cv2.putText(tile, when, (TILE_W - 8 - when_w, 20), FONT, 0.42, SUBINK, 1, AA)
-    cv2.putText(tile, _fit(sample.room or "outside the rooms", TILE_W - 60 - when_w, BOLD, 0.52), (38, 20),
-                BOLD, 0.52, INK, 1, AA)
+    when_w = _width(figure, when, SMALL_PT)
+    _text(figure, x + TILE_W - 8 - when_w, y + 20, when, SMALL_PT, SUBINK)
+    room = _fit(figure, sample.room or "outside the rooms", TILE_W - 60 - when_w, TEXT_PT, "bold")
+    _text(figure, x + 38, y + 20, room, TEXT_PT, INK, weight="bold")
     objects = ", ".join(k if c == 1 else f"{c} {k}" for k, c in seen.most_common()) or "no objects in view"
-    cv2.putText(tile, _fit(objects, TILE_W - 46, FONT, 0.42), (38, 39), FONT, 0.42, SUBINK, 1, AA)
-    tile[HEAD_H:HEAD_H + TILE_H] = cv2.resize(cv2.cvtColor(sample.rgb, cv2.COLOR_RGB2BGR), (TILE_W, TILE_H),
-                                              interpolation=cv2.INTER_AREA)
-    bottom = HEAD_H + TILE_H
-    tile[bottom:, :half[0]] = cv2.resize(colourise_depth(sample.depth), half, interpolation=cv2.INTER_NEAREST)
-    tile[bottom:, half[0]:] = cv2.resize(cv2.cvtColor(sample.mask, cv2.COLOR_RGB2BGR), half,
-                                         interpolation=cv2.INTER_NEAREST)
-    cv2.line(tile, (half[0], bottom), (half[0], tile.shape[0]), PAPER, 1)
-    cv2.rectangle(tile, (0, 0), (TILE_W - 1, tile.shape[0] - 1), (200, 200, 200), 1)
-    return tile
-
-
-def _fit(text: str, width: int, font: int, scale: float) -> str:
-    """``text``, cut and ended with an ellipsis if it is wider than ``width`` pixels."""
-    if cv2.getTextSize(text, font, scale, 1)[0][0] <= width:
-        return text
-    while text and cv2.getTextSize(text + "...", font, scale, 1)[0][0] > width:
-        text = text[:-1]
-    return text.rstrip(", ") + "..."
+    _text(figure, x + 38, y + 39, _fit(figure, objects, TILE_W - 46, SMALL_PT), SMALL_PT, SUBINK)
+    _image(figure, cv2.resize(sample.rgb, (TILE_W, TILE_H), interpolation=cv2.INTER_AREA), x, y + HEAD_H)
+    bottom = y + HEAD_H + TILE_H
+    depth = cv2.cvtColor(colourise_depth(sample.depth), cv2.COLOR_BGR2RGB)
+    _image(figure, cv2.resize(depth, half, interpolation=cv2.INTER_NEAREST), x, bottom)
+    _image(figure, cv2.resize(sample.mask, half, interpolation=cv2.INTER_NEAREST), x + half[0], bottom)
+    _box(figure, x, y, TILE_W, TILE_H_ALL, edge=(200, 200, 200))
 
 
 def colourise_depth(metres: np.ndarray) -> np.ndarray:
     """BGR picture of a depth image: turbo over :data:`DEPTH_RANGE_M`, black where there is no depth."""
     lo, hi = DEPTH_RANGE_M
     scaled = np.nan_to_num((metres - lo) / (hi - lo), nan=0.0)
-    image = cv2.applyColorMap((np.clip(scaled, 0, 1) * 255).astype(np.uint8), cv2.COLORMAP_TURBO)
+    image = DEPTH_MAP(np.clip(scaled, 0, 1), bytes=True)[..., 2::-1].copy()
     image[~np.isfinite(metres)] = 0
     return image
 
 
-def _depth_scale(img: np.ndarray, origin: tuple[int, int]) -> None:
-    """The depth colour bar with its end labels."""
-    x, y = origin
-    bar = cv2.applyColorMap(np.tile(np.linspace(0, 255, 200).astype(np.uint8), (12, 1)), cv2.COLORMAP_TURBO)
-    img[y:y + 12, x + 50:x + 250] = bar
-    lo, hi = DEPTH_RANGE_M
-    cv2.putText(img, "depth", (x, y + 11), FONT, 0.45, SUBINK, 1, AA)
-    cv2.putText(img, f"{lo:g}", (x + 46, y + 30), FONT, 0.42, SUBINK, 1, AA)
-    cv2.putText(img, f"{hi:g} m", (x + 238, y + 30), FONT, 0.42, SUBINK, 1, AA)
+def _depth_scale(figure: Figure, x: int, y: int) -> None:
+    """The depth colour bar (200 x 12 px) with its range, its left end at pixel (x, y)."""
+    axes = figure.add_axes((x / figure.bbox.width, 1 - (y + 12) / figure.bbox.height,
+                            200 / figure.bbox.width, 12 / figure.bbox.height))
+    bar = Colorbar(axes, cmap=DEPTH_MAP, norm=Normalize(*DEPTH_RANGE_M), orientation="horizontal")
+    bar.outline.set_visible(False)
+    bar.set_ticks(DEPTH_RANGE_M, labels=[f"{DEPTH_RANGE_M[0]:g}", f"{DEPTH_RANGE_M[1]:g} m"])
+    axes.tick_params(labelsize=SMALL_PT, colors=rgb(SUBINK), length=2)
+    _text(figure, x - 46, y + 11, "depth", SMALL_PT, SUBINK)
 
 
-def _pad(img: np.ndarray, size: int, axis: int) -> np.ndarray:
-    """``img`` extended with white to ``size`` rows (axis 0, below) or columns (axis 1, centred)."""
-    extra = size - img.shape[axis]
-    if extra <= 0:
-        return img
-    before = 0 if axis == 0 else extra // 2
-    pad = [(0, 0)] * 3
-    pad[axis] = (before, extra - before)
-    return np.pad(img, pad, constant_values=255)
+# --------------------------------------------------------------------------- pixel placement
+
+def _y(figure: Figure, v: float) -> float:
+    """matplotlib's pixel y (up from the bottom) of a picture row v (down from the top)."""
+    return figure.bbox.height - v
+
+
+def _image(figure: Figure, picture: np.ndarray, x: int, y: int) -> None:
+    """An RGB picture, unscaled, with its top-left corner at pixel (x, y)."""
+    figure.figimage(picture, xo=x, yo=int(_y(figure, y + picture.shape[0])), origin="upper")
+
+
+def _box(figure: Figure, x: float, y: float, w: float, h: float, fill: tuple[int, int, int] | None = None,
+         edge: tuple[int, int, int] | None = None) -> None:
+    figure.add_artist(Rectangle((x, _y(figure, y + h)), w, h, transform=IdentityTransform(), linewidth=1,
+                                facecolor=rgb(fill) if fill else "none", edgecolor=rgb(edge) if edge else "none",
+                                zorder=0 if fill else 3))
+
+
+def _text(figure: Figure, x: float, y: float, text: str, size: float, colour: tuple[int, int, int],
+          weight: str = "normal") -> None:
+    """One line with its left baseline point at pixel (x, y)."""
+    figure.text(x, _y(figure, y), text, fontsize=size, color=rgb(colour), weight=weight,
+                transform=IdentityTransform())
+
+
+def _width(figure: Figure, text: str, size: float, weight: str = "normal") -> float:
+    renderer = figure.canvas.get_renderer()      # type: ignore[attr-defined]
+    return renderer.get_text_width_height_descent(text, FontProperties(size=size, weight=weight), ismath=False)[0]
+
+
+def _fit(figure: Figure, text: str, width: float, size: float, weight: str = "normal") -> str:
+    """``text``, cut and ended with an ellipsis if it is wider than ``width`` pixels."""
+    if _width(figure, text, size, weight) <= width:
+        return text
+    while text and _width(figure, text + "...", size, weight) > width:
+        text = text[:-1]
+    return text.rstrip(", ") + "..."

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 
+from ravh_sim.poses import pose_matrix
 from ravh_sim.render.materials import MaterialTable
 from ravh_sim.world.library import FittedModel
 from ravh_sim.world.mesh import Mesh
@@ -68,15 +69,6 @@ def _scatter(normals: np.ndarray, valid: np.ndarray, count: int) -> np.ndarray:
     out = np.zeros((count, 3))
     out[valid] = normals
     return out
-
-
-def pose_matrix(position, orientation) -> np.ndarray:
-    """3x4 [R | t] of a pybullet pose (quaternion x, y, z, w)."""
-    x, y, z, w = orientation
-    r = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                  [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                  [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-    return np.hstack([r, np.asarray(position, np.float64)[:, None]])
 
 
 class SceneBuilder:

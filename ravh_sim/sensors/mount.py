@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ravh_msgs_py.names import CAMERA_OPTICAL_FRAME, LASER_FRAME
+from ravh_sim.poses import rotation_y, rotation_z
 
 if TYPE_CHECKING:
     from ravh_sim.world.scene import World
@@ -34,11 +35,7 @@ def floor_at(world: World, x: float, y: float) -> float:
 
 def mount_rotation(yaw: float, pitch_down: float = 0.0) -> np.ndarray:
     """Rotation (3x3, columns = axes in the house frame) of a sensor link yawed then pitched down."""
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    cp, sp = math.cos(pitch_down), math.sin(pitch_down)
-    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
-    ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])   # +pitch about y tips x down
-    return rz @ ry
+    return rotation_z(yaw) @ rotation_y(pitch_down)
 
 
 def mount_position(x: float, y: float, yaw: float, floor_z: float, height: float,

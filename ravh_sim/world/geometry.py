@@ -1,107 +1,80 @@
-"""Small 2D geometry helpers on floor polygons and wall segments (pure Python/numpy)."""
+"""2D geometry on floor polygons: shapely's tests and measures over the house files' outlines.
+
+Outlines are tuples of (x, y) points, as the house files give them. Triangulation stays an ear
+clipping of our own: the floor meshes index the outline's own vertices, which shapely's
+triangulations (new vertices, Delaunay) do not keep.
+"""
 from __future__ import annotations
 
-import math
+import functools
+from collections.abc import Sequence
 
 import numpy as np
+import shapely
+
+from ravh_sim.poses import rotation_z
 
 Polygon = tuple[tuple[float, float], ...]
 
 
+def shape(poly: Sequence[Sequence[float]]) -> shapely.Polygon:
+    """The shapely polygon of an outline, built once per outline and prepared for fast tests."""
+    return _prepared(tuple((float(x), float(y)) for x, y in poly))
+
+
+@functools.lru_cache(maxsize=4096)
+def _prepared(poly: Polygon) -> shapely.Polygon:
+    polygon = shapely.Polygon(poly)
+    shapely.prepare(polygon)
+    return polygon
+
+
 def polygon_area(poly: Polygon) -> float:
-    """Unsigned area by the shoelace formula."""
-    s = 0.0
-    for (x0, y0), (x1, y1) in zip(poly, poly[1:] + poly[:1]):
-        s += x0 * y1 - x1 * y0
-    return abs(s) / 2.0
+    return float(shape(poly).area)
 
 
 def point_in_polygon(x: float, y: float, poly: Polygon) -> bool:
-    """Even-odd ray casting; points on an edge may fall either way."""
-    inside = False
-    n = len(poly)
-    for i in range(n):
-        x0, y0 = poly[i]
-        x1, y1 = poly[(i + 1) % n]
-        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
-            inside = not inside
-    return inside
+    """Whether (x, y) lies inside ``poly`` or on its outline."""
+    return bool(shapely.intersects_xy(shape(poly), x, y))
 
 
 def points_in_polygon(xs: np.ndarray, ys: np.ndarray, poly: Polygon) -> np.ndarray:
     """Vectorised :func:`point_in_polygon` over arrays of equal shape."""
-    inside = np.zeros(np.shape(xs), dtype=bool)
-    n = len(poly)
-    for i in range(n):
-        x0, y0 = poly[i]
-        x1, y1 = poly[(i + 1) % n]
-        if y0 == y1:
-            continue
-        crosses = (y0 > ys) != (y1 > ys)
-        x_cross = x0 + (ys - y0) * (x1 - x0) / (y1 - y0)
-        inside ^= crosses & (xs < x_cross)
-    return inside
+    return shapely.intersects_xy(shape(poly), xs, ys)
 
 
 def distance_to_polygon(x: float, y: float, poly: Polygon) -> float:
     """Distance from (x, y) to the outline of ``poly`` (0 on an edge)."""
-    return min(_distance_to_segment(x, y, a, b) for a, b in zip(poly, poly[1:] + poly[:1]))
-
-
-def _distance_to_segment(x: float, y: float, a, b) -> float:
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    length2 = dx * dx + dy * dy
-    t = 0.0 if length2 == 0 else max(0.0, min(1.0, ((x - a[0]) * dx + (y - a[1]) * dy) / length2))
-    return math.hypot(x - a[0] - t * dx, y - a[1] - t * dy)
+    return float(shapely.distance(shape(poly).exterior, shapely.Point(x, y)))
 
 
 def self_intersection(poly: Polygon) -> tuple[int, int] | None:
     """The first pair of non-adjacent edges (i, j) that cross or touch; None for a simple polygon."""
+    if shapely.LinearRing(poly).is_simple:
+        return None
     n = len(poly)
-    edges = [(poly[i], poly[(i + 1) % n]) for i in range(n)]
+    edges = shapely.linestrings([(poly[i], poly[(i + 1) % n]) for i in range(n)])
     for i in range(n):
-        for j in range(i + 2, n):
-            if i == 0 and j == n - 1:
-                continue                       # the closing edge meets the first one at a vertex
-            if _segments_meet(*edges[i], *edges[j]):
-                return i, j
+        last = n - 1 if i == 0 else n          # the closing edge meets the first one at a vertex
+        meets = np.flatnonzero(shapely.intersects(edges[i], edges[i + 2:last]))
+        if meets.size:
+            return i, i + 2 + int(meets[0])
     return None
 
 
-def _segments_meet(a, b, c, d) -> bool:
-    d1, d2, d3, d4 = _cross(c, d, a), _cross(c, d, b), _cross(a, b, c), _cross(a, b, d)
-    if (d1 > 0) != (d2 > 0) and (d3 > 0) != (d4 > 0) and 0 not in (d1, d2, d3, d4):
-        return True
-    return any(abs(o) < 1e-12 and _on_segment(p, q, r) for o, p, q, r in (
-        (d1, c, d, a), (d2, c, d, b), (d3, a, b, c), (d4, a, b, d)))
-
-
-def _on_segment(p, q, r) -> bool:
-    """r lies within the bounding box of segment pq (r is known to be collinear)."""
-    return min(p[0], q[0]) - 1e-12 <= r[0] <= max(p[0], q[0]) + 1e-12 and \
-        min(p[1], q[1]) - 1e-12 <= r[1] <= max(p[1], q[1]) + 1e-12
-
-
 def polygon_centroid(poly: Polygon) -> tuple[float, float]:
-    """Area centroid (falls back to the vertex mean for degenerate polygons)."""
-    a = cx = cy = 0.0
-    for (x0, y0), (x1, y1) in zip(poly, poly[1:] + poly[:1]):
-        c = x0 * y1 - x1 * y0
-        a += c
-        cx += (x0 + x1) * c
-        cy += (y0 + y1) * c
-    if abs(a) < 1e-12:
+    """Area centroid (the vertex mean for degenerate polygons)."""
+    centre = shape(poly).centroid
+    if shape(poly).area < 1e-12 or centre.is_empty:
         return (sum(p[0] for p in poly) / len(poly), sum(p[1] for p in poly) / len(poly))
-    return (cx / (3 * a), cy / (3 * a))
+    return (centre.x, centre.y)
 
 
 def box_corners(center: tuple[float, float], size: tuple[float, float], yaw: float) -> np.ndarray:
     """The 4 corners (4, 2) of a yawed rectangle, counter-clockwise."""
-    c, s = math.cos(yaw), math.sin(yaw)
     hx, hy = size[0] / 2, size[1] / 2
     local = np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
-    rot = np.array([[c, -s], [s, c]])
-    return local @ rot.T + np.asarray(center)
+    return local @ rotation_z(yaw)[:2, :2].T + np.asarray(center)
 
 
 def triangulate(poly: Polygon) -> list[tuple[int, int, int]]:

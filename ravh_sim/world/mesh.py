@@ -18,6 +18,8 @@ from typing import Protocol
 
 import numpy as np
 
+from ravh_sim.poses import rotation_z
+
 Vec3 = Sequence[float] | np.ndarray          # three floats, as a sequence or an array
 
 
@@ -124,22 +126,6 @@ class Mesh:
 def _clean(values: np.ndarray, decimals: int) -> np.ndarray:
     """Round and turn negative zeros positive so printed text is canonical."""
     return np.round(values, decimals) + 0.0
-
-
-def rotation_z(angle: float) -> np.ndarray:
-    """Rotation matrix about +z; exact for multiples of a quarter turn."""
-    quarter = angle / (np.pi / 2)
-    if np.isclose(quarter, round(quarter), rtol=0.0, atol=1e-12):
-        c, s = [(1, 0), (0, 1), (-1, 0), (0, -1)][round(quarter) % 4]
-    else:
-        c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def rotation_y(angle: float) -> np.ndarray:
-    """Rotation matrix about +y (tilts +x towards -z for positive angles)."""
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 # --- primitives -------------------------------------------------------------
