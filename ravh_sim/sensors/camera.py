@@ -8,7 +8,8 @@ axis in metres (NaN where nothing is hit within ``far``); instance ids are the W
 The camera never talks GL or pybullet. Optional effects (motion blur, lens distortion, noise, JPEG)
 follow in that order, seeded from the world seed, the agent and a capture counter so the same seed
 and poses give identical images.
-:data:`PORT` is the camera as a sensor port (ravh_sim.sensors.ports).
+:class:`CameraSection` is the camera's section of a robot profile, :data:`PORT` the camera as a
+sensor port (ravh_sim.sensors.ports).
 """
 from __future__ import annotations
 
@@ -54,6 +55,7 @@ Coefficient = Annotated[float, Field(ge=-10.0, le=10.0), FINITE]     # of lens d
 
 @dataclass(frozen=True)
 class CameraSpec:
+    """What a camera is built with (from its profile section)."""
     height: float            # m above the floor
     pitch_deg: float         # down
     forward: float           # m ahead of the base centre

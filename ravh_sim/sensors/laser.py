@@ -7,8 +7,8 @@ bodies sit in collision groups that the rays' mask leaves out (:meth:`World.ray_
 ever hits them, wherever it starts (a ray starting inside a convex body may or may not hit it).
 Open doors are moved out of the house by the World, so the laser sees through open doorways;
 closed doors, walls and furniture parts (legs, not their bounding boxes) stop it. Noise is
-Gaussian, seeded from the world seed, the agent and a scan counter. :data:`PORT` is the laser as a
-sensor port (ravh_sim.sensors.ports).
+Gaussian, seeded from the world seed, the agent and a scan counter. :class:`LaserSection` is the
+laser's section of a robot profile, :data:`PORT` the laser as a sensor port (ravh_sim.sensors.ports).
 """
 from __future__ import annotations
 
@@ -33,13 +33,14 @@ if TYPE_CHECKING:
     from ravh_sim.world.scene import World
 
 NOISE_STREAM = 2            # noise generator stream of lasers (cameras use another)
-MAX_RAYS = 16384           # pybullet's rayTestBatch limit: more ends the sim with "Number of rays exceed..."
+MAX_RAYS = 16384            # pybullet's rayTestBatch limit: more ends the sim with "Number of rays exceed..."
 STAGES = (1.5, 4.0, 10.0)   # m: ray lengths of the first cast stages (then range_max)
 STAGE_OVERLAP = 0.01        # m: a stage starts this much before the previous one ended
 
 
 @dataclass(frozen=True)
 class LaserSpec:
+    """What a laser is built with (from its profile section)."""
     height: float            # m above the floor
     fov_deg: float
     resolution_deg: float
