@@ -46,6 +46,7 @@ def bench_load(houses: list[int] | None = None) -> dict[str, Any]:
     Baselines: the same build with an empty asset cache (first run on a machine), and a bare pybullet
     client with the renderer loaded (the fixed cost every build pays).
     """
+    from ravh_sim.render.backend import resolve_backend
     from ravh_sim.world.house import available_houses, load_house
     from ravh_sim.world.scene import World
     from ravh_sim.world.settings import load_settings, resolve
@@ -56,7 +57,7 @@ def bench_load(houses: list[int] | None = None) -> dict[str, Any]:
     def build(n: int) -> tuple[float, int]:
         def make() -> int:
             house = load_house(n)
-            world = World(house, resolve(settings, house))
+            world = World(house, resolve(settings, house), renderer=resolve_backend("auto"))
             tris = world.triangle_count
             world.close()
             return tris
@@ -240,6 +241,7 @@ def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
     """
     from dataclasses import replace
 
+    from ravh_sim.render.backend import resolve_backend
     from ravh_sim.robot.profile import load_profile
     from ravh_sim.sensors.camera import SmartCamera
     from ravh_sim.sensors.laser import Laser
@@ -265,7 +267,7 @@ def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
             if room.contains(cx, cy):
                 poses.append((cx, cy, i * math.pi / 2))
         for name, (backend, quality) in configs.items():
-            world = World(house, resolve(settings, house), renderer=backend)
+            world = World(house, resolve(settings, house), renderer=resolve_backend(backend))
             if world.renderer != backend:
                 world.close()
                 continue

@@ -23,7 +23,7 @@ from ravh_sim.nodes.launch import NODES
 from ravh_sim.nodes.launch import main as launch_node
 from ravh_sim.paths import FURNITURE_DIR, HOUSES_DIR
 from ravh_sim.raids.build import add_parser as add_dataset_parser
-from ravh_sim.render.backend import BACKENDS
+from ravh_sim.render.backend import BACKENDS, resolve_backend
 
 Command = Callable[[argparse.Namespace], int]
 
@@ -181,7 +181,7 @@ def cmd_render(args: argparse.Namespace) -> int:
     from ravh_sim.world.scene import World
     house, resolved = _resolved(args)
     house.room_at_or_raise(*args.pose[:2])           # an all-sky picture from outside helps nobody
-    with World(house, resolved, renderer=args.renderer) as world:
+    with World(house, resolved, renderer=resolve_backend(args.renderer)) as world:
         appearance = Appearance(world)
         if args.sun is not None:
             appearance.set_sun(_sun_value(args.sun))

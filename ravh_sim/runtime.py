@@ -25,6 +25,7 @@ from ravh_sim.errors import UserError
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.nav.planner import Path as PlannedPath
 from ravh_sim.poses import compose, matrix_from_quaternion, relative
+from ravh_sim.render.backend import resolve_backend
 from ravh_sim.robot.profile import RobotProfile, load_profile
 from ravh_sim.robot.robot import Robot
 from ravh_sim.robot.simulation import Simulation
@@ -78,7 +79,7 @@ class SimRuntime:
             self.house = house if isinstance(house, House) else load_house(house)
             resolved = resolve(load_settings(config), self.house, seed, str(config or "config/default.yaml"))
         self.initial = resolved
-        self.world = World(self.house, resolved, renderer=renderer)
+        self.world = World(self.house, resolved, renderer=resolve_backend(renderer))
         self.appearance = Appearance(self.world)
         self.sim = Simulation(self.world)
         self.agents = []

@@ -13,6 +13,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from ravh_sim.render.backend import resolve_backend
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.sensors.agreement import laser_minus_depth
 from ravh_sim.sensors.camera import SmartCamera
@@ -37,7 +38,8 @@ def test_laser_and_depth_agree_on_walls_objects_and_doors(houses, number):
     it; all doors closed."""
     house = houses[number]
     settings = resolve(load_settings(), house)
-    with World(house, replace(settings, doors=dict.fromkeys(settings.doors, False))) as world:
+    with World(house, replace(settings, doors=dict.fromkeys(settings.doors, False)),
+               renderer=resolve_backend("auto")) as world:
         camera, laser = SmartCamera(world, PROFILE.camera), Laser(world, PROFILE.laser)
         poses = [(house.station.position[0], house.station.position[1], house.station.yaw)]
         for room in house.rooms:
@@ -77,7 +79,7 @@ def test_no_cracks_around_doors(houses, number):
     house = houses[number]
     settings = resolve(load_settings(), house)
     doors = {d.id: settings.doors[d.id] and len(d.rooms) == 2 for d in house.doors}
-    with World(house, replace(settings, doors=doors)) as world:
+    with World(house, replace(settings, doors=doors), renderer=resolve_backend("auto")) as world:
         camera = SmartCamera(world, PROFILE.camera)
         captures = 0
         for door in house.doors:

@@ -127,9 +127,11 @@ def test_the_cycle_finder_finds_a_cycle():
 LAYERS: list[tuple[str, ...]] = [
     ("ravh_msgs_py", "ravh_sim", "ravh_sim.errors", "ravh_sim.paths", "ravh_sim.files", "ravh_sim.poses",
      "ravh_sim.schema", "ravh_sim.paper"),
-    ("ravh_sim.world", "ravh_sim.render"),      # the scene picks its render backend; renderers draw the scene
+    ("ravh_sim.world",),                         # the house and its physics, told which backend draws it
+    ("ravh_sim.render",),                        # draws the world; whoever builds both resolves the backend here
     ("ravh_sim.sensors",),                       # each declares its profile section, files and topics
-    ("ravh_sim.robot", "ravh_sim.nav"),          # a profile's body drives the planner; agents start on free space
+    ("ravh_sim.nav",),                           # maps and paths; reads a robot's size and limits via Protocols
+    ("ravh_sim.robot",),                         # a profile's body in the physics; agents start on nav's free space
     ("ravh_sim.dataset",),                       # the format: written and read through the sensor ports
     ("ravh_sim.viz",),                           # pictures of a house
     ("ravh_sim.behaviours",),

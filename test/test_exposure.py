@@ -16,6 +16,7 @@ from test_sensors import PROFILE
 
 from ravh_sim.nav.grid import FREE
 from ravh_sim.nav.navigation import Navigation
+from ravh_sim.render.backend import resolve_backend
 from ravh_sim.render.gl_renderer import GLRenderer, RenderError
 from ravh_sim.sensors.camera import SmartCamera
 from ravh_sim.world.appearance import Appearance
@@ -54,7 +55,7 @@ def test_random_views_are_exposed_plausibly(number):
     house = load_house(number)
     rng = np.random.default_rng(number)
     bad = []
-    with World(house, resolve(load_settings(), house, 0)) as world:
+    with World(house, resolve(load_settings(), house, 0), renderer=resolve_backend("auto")) as world:
         camera, appearance = _gl_camera(world), Appearance(world)
         poses = _free_poses(world, POSES_PER_HOUSE, rng)
         start = 0
@@ -74,7 +75,7 @@ def test_random_views_are_exposed_plausibly(number):
 def black_view_world():
     number, _ = WAS_BLACK
     house = load_house(number)
-    with World(house, resolve(load_settings(), house, 0)) as world:
+    with World(house, resolve(load_settings(), house, 0), renderer=resolve_backend("auto")) as world:
         Appearance(world).set_sun("day")
         yield world
 

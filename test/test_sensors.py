@@ -22,6 +22,7 @@ from ravh_sim.nav.follower import PathFollower, Status
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.nav.planner import Unreachable
 from ravh_sim.poses import quaternion_from_matrix
+from ravh_sim.render.backend import resolve_backend
 from ravh_sim.render.projection import projection_from_K
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.robot.simulation import Simulation
@@ -105,7 +106,7 @@ def box_house():
 
 
 def _world(house, renderer="auto", seed=0):
-    return World(house, resolve(load_settings(), house, seed), renderer=renderer)
+    return World(house, resolve(load_settings(), house, seed), renderer=resolve_backend(renderer))
 
 
 @pytest.fixture(scope="module")

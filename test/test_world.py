@@ -9,6 +9,7 @@ import pybullet as pb
 import pytest
 from conftest import resolved
 
+from ravh_sim.render.backend import resolve_backend
 from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import build_instances, make_footprint
 from ravh_sim.world.scene import World
@@ -87,9 +88,11 @@ def test_model_swap_rebuilds_the_body(houses):
         assert world.body_to_instance_lut()[world.instance("Bed_0").body] == inst.id
 
 
-def test_gl_or_fallback_renderer_is_reported(houses):
-    with World(houses[20], resolved(houses[20])) as world:
+def test_the_world_is_drawn_by_the_backend_its_builder_resolved(houses):
+    with World(houses[20], resolved(houses[20]), renderer=resolve_backend("auto")) as world:
         assert world.renderer in ("gl", "tiny")
+    with pytest.raises(ValueError, match="resolved backend"):
+        World(houses[20], resolved(houses[20]), renderer="auto")
 
 
 def test_every_variant_of_every_object_lies_in_its_footprint_box(houses):

@@ -21,15 +21,11 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import Enum
-from typing import TYPE_CHECKING, Protocol
+from typing import Protocol
 
 from ravh_sim.nav.grid import Grid
 from ravh_sim.nav.planner import Path, Point, Unreachable
 from ravh_sim.poses import Pose2D, wrap_angle
-from ravh_sim.robot.profile import RobotProfile
-
-if TYPE_CHECKING:
-    from ravh_sim.robot.simulation import Simulation
 
 CONTROL_PERIOD = 0.05            # s between follower updates in :func:`drive` (20 Hz, as nav2)
 
@@ -150,6 +146,29 @@ class Drivable(Protocol):
     def set_command(self, v: float, w: float) -> None: ...
 
 
+class SpeedLimits(Protocol):
+    """What the follower needs of a robot profile (a :class:`~ravh_sim.robot.profile.RobotProfile`):
+    navigation sits below ravh_sim.robot, so it names what it reads instead of importing the profile."""
+
+    @property
+    def max_linear_speed(self) -> float: ...
+
+    @property
+    def max_angular_speed(self) -> float: ...
+
+
+class Clock(Protocol):
+    """What :func:`drive` needs of a simulation (a :class:`~ravh_sim.robot.simulation.Simulation`)."""
+
+    @property
+    def dt(self) -> float: ...
+
+    @property
+    def time(self) -> float: ...
+
+    def step(self, n: int = 1) -> None: ...
+
+
 class MapProvider(Protocol):
     """What the follower needs of navigation (a :class:`~ravh_sim.nav.navigation.Navigation`)."""
 
@@ -170,7 +189,7 @@ class PathFollower:
     Call :meth:`navigate_to` (or :meth:`follow`), then :meth:`update` at the control rate.
     """
 
-    def __init__(self, robot: Drivable, navigation: MapProvider, profile: RobotProfile,
+    def __init__(self, robot: Drivable, navigation: MapProvider, profile: SpeedLimits,
                  config: FollowerConfig | None = None) -> None:
         self.robot, self.navigation, self.profile = robot, navigation, profile
         self.config = config or FollowerConfig()
@@ -341,7 +360,7 @@ class PathFollower:
         return self.status
 
 
-def drive(simulation: Simulation, follower: PathFollower, timeout: float,
+def drive(simulation: Clock, follower: PathFollower, timeout: float,
           period: float = CONTROL_PERIOD) -> Status:
     """Run ``simulation`` with ``follower`` in the loop every ``period`` seconds until it arrives or
     fails, or ``timeout`` simulated seconds pass (then the robot keeps its last command)."""

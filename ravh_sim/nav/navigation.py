@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from pathlib import Path as FilePath
+from typing import Protocol
 
 import numpy as np
 
@@ -22,7 +23,7 @@ from ravh_sim.nav.grid import FREE, Grid, distance_to_obstacle, reachable
 from ravh_sim.nav.mapio import write_map
 from ravh_sim.nav.obstaclemap import obstacle_map
 from ravh_sim.nav.planner import Path, Point, Unreachable, densify, plan_path
-from ravh_sim.robot.profile import RobotProfile
+from ravh_sim.sensors.laser import LaserSpec
 from ravh_sim.world.house import House
 from ravh_sim.world.state import WorldState
 
@@ -30,10 +31,25 @@ DEFAULT_RESOLUTION = 0.05        # m per cell, as the ROS map_server maps the pr
 START_SNAP = 0.3                 # m, as the planner: a start on the inflation uses the free cell nearby
 
 
+class Body(Protocol):
+    """What the maps need of a robot profile (a :class:`~ravh_sim.robot.profile.RobotProfile`): its
+    size and its laser's height. Navigation sits below ravh_sim.robot, which starts agents on its free
+    space, so it names what it reads instead of importing the profile."""
+
+    @property
+    def radius(self) -> float: ...
+
+    @property
+    def height(self) -> float: ...
+
+    @property
+    def laser(self) -> LaserSpec: ...
+
+
 class Navigation:
     """Maps and planner for one robot profile (its radius, height and laser height shape the maps)."""
 
-    def __init__(self, house: House, state: WorldState, profile: RobotProfile,
+    def __init__(self, house: House, state: WorldState, profile: Body,
                  resolution: float = DEFAULT_RESOLUTION) -> None:
         self.house, self.state, self.profile, self.resolution = house, state, profile, resolution
         self._built_at = state.layout_revision

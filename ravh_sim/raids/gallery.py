@@ -14,6 +14,7 @@ import cv2
 import numpy as np
 
 from ravh_sim.raids.raid import PRESETS, preset_settings
+from ravh_sim.render.backend import resolve_backend
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.sensors.camera import SmartCamera
 from ravh_sim.viz.figure import figure_bgr, new_figure
@@ -60,7 +61,7 @@ def gallery(house_number: int, output: Path, seed: int = 0,
     """Write the contact sheet (3 x 2 panels) to ``output``; returns it."""
     house = load_house(house_number)
     profile = load_profile()
-    with World(house, _preset(house, 0, seed), renderer=renderer) as world:
+    with World(house, _preset(house, 0, seed), renderer=resolve_backend(renderer)) as world:
         appearance = Appearance(world)
         if pose is None:
             scout = SmartCamera(world, replace(profile.camera, quality="fast"))
@@ -143,7 +144,7 @@ def object_gallery(house_number: int, output: Path, seed: int = 0, renderer: str
     look) and at night with the lights on (raid 4's), side by side."""
     house = load_house(house_number)
     profile = load_profile()
-    with World(house, _preset(house, 0, seed), renderer=renderer) as world:
+    with World(house, _preset(house, 0, seed), renderer=resolve_backend(renderer)) as world:
         appearance = Appearance(world)
         scout = SmartCamera(world, replace(profile.camera, quality="fast"))
         views = object_views(world, scout)

@@ -13,7 +13,8 @@ It also keeps what every body looks like (:attr:`World.visuals`: the mesh, its p
 :attr:`World.revision` that grows with every change to them (doors, models, paint), so a renderer
 (ravh_sim.render) can rebuild its GPU copy of the house only when one happened. pybullet's own renderer is used only
 by the TinyRenderer fallback; the EGL plugin is never loaded (one GL context per process belongs to
-ravh_sim.render).
+ravh_sim.render). The World sits below its renderers: whoever builds it picks the backend
+(:func:`ravh_sim.render.backend.resolve_backend`) and tells it which one will draw it.
 """
 from __future__ import annotations
 
@@ -31,7 +32,6 @@ import numpy as np
 import pybullet as pb
 
 from ravh_sim.poses import quaternion_from_yaw
-from ravh_sim.render.backend import resolve_backend
 from ravh_sim.world import paints
 from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances
 from ravh_sim.world.house import House, HouseObject, Wall
@@ -74,12 +74,14 @@ def disconnect(client: int) -> None:
 class World:
     """A house built in its own pybullet client (DIRECT: headless)."""
 
-    def __init__(self, house: House, settings: Resolved, renderer: str = "auto",
-                 physics_hz: float = 240.0) -> None:
+    def __init__(self, house: House, settings: Resolved, renderer: str, physics_hz: float = 240.0) -> None:
+        """``renderer``: the resolved backend that will draw this world, ``gl`` or ``tiny``."""
+        if renderer not in ("gl", "tiny"):
+            raise ValueError(f"renderer must be a resolved backend, 'gl' or 'tiny', got {renderer!r}")
         self.house = house
         self.state = WorldState(settings)
         self.physics_hz = physics_hz
-        self.renderer = resolve_backend(renderer)
+        self.renderer = renderer
         self._pybullet_draws = self.renderer == "tiny"        # else pybullet bodies need no visual shape
         self.client = connect()
         self.visuals: dict[int, Visual] = {}     # pybullet body -> what it looks like
