@@ -100,6 +100,8 @@ class Looks(BaseModel):
     doors: Items[bool]                     # door id -> open
     paint: Items[Items[str]]               # room id -> {"walls": paint, "floor": paint}
     models: Items[Annotated[int, Field(ge=0)]]   # object id -> model variant
+    # every light's colour temperature; at the default, the colours the house files give the lights
+    light_temperature: Annotated[float, Knob("kelvin", 1000.0, 10000.0)] = 2700.0
 
     def changed(self, **fields: Any) -> Self:
         """A copy with ``fields`` replaced, validated like the original (a ValueError if one is bad)."""

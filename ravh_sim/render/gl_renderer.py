@@ -32,7 +32,7 @@ from ravh_sim.render.geometry import ATTRIBUTES, VERTEX_FORMAT, SceneBuilder
 from ravh_sim.render.materials import NOISE_TEXELS, PATTERN, TEXELS, MaterialTable, noise_volume, srgb8_to_linear
 from ravh_sim.render.projection import look_at, orthographic, perspective, projection_from_K, view_matrix
 from ravh_sim.render.views import RenderedViews
-from ravh_sim.world.appearance import SunLight, sun_light
+from ravh_sim.world.appearance import SunLight, lamps_at, sun_light
 from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import Light
 from ravh_sim.world.scene import World
@@ -83,7 +83,7 @@ METER_BLOCK = 16                      # pixels per side averaged by one metering
 # Fields of the world state (ravh_msgs_py.appearance.Looks) that _sync redraws for: geometry redoes
 # everything, lighting the light state and the light maps.
 GEOMETRY_FIELDS = frozenset({"doors", "models", "paint"})
-LIGHTING_FIELDS = frozenset({"sun_angle", "lights"})
+LIGHTING_FIELDS = frozenset({"sun_angle", "lights", "light_temperature"})
 
 
 class RenderError(RuntimeError):
@@ -287,11 +287,13 @@ class GLRenderer:
             changed |= {"sun_angle"}
         if not changed & LIGHTING_FIELDS:
             return
+        if "light_temperature" in changed:
+            self._lights_on = None                # every light's colour moved: relight every room
         sun_changed = "sun_angle" in changed
         on = frozenset(k for k, v in world.state.lights.items() if v)
         switched = on ^ self._lights_on if self._lights_on is not None else None
         sun = sun_light(world.state.sun_angle)
-        lights = [lt for lt in world.house.lights if lt.id in on]
+        lights = lamps_at([lt for lt in world.house.lights if lt.id in on], world.state.settings().light_temperature)
         self._upload_instances(sun, lights)
         self._set_lighting(sun, lights)
         self._lights_on = on

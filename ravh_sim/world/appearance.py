@@ -10,22 +10,24 @@ switching them costs nothing. Random choices go through
 :func:`settings.resolve`, so "random" here picks exactly what the same seed picks in a settings file.
 
 The sun model (:func:`sun_light`) is here too: one angle gives the light direction, the colour and
-level of daylight indoors and the sky colour seen beyond the house and through the windows.
+level of daylight indoors and the sky colour seen beyond the house and through the windows; and the
+lamp model (:func:`lamps_at`): the lights' colours at a colour temperature.
 """
 from __future__ import annotations
 
 import contextlib
 import copy
 import math
-from collections.abc import Mapping
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Any
 
-from ravh_msgs_py.appearance import KNOBS, LIGHT_GROUPS, SURFACES, SWITCH
+from ravh_msgs_py.appearance import KNOBS, LIGHT_GROUPS, SURFACES, SWITCH, Looks
 from ravh_msgs_py.query import UNKNOWN_ID, QueryError
 from ravh_sim.errors import UnknownNameError, UserError
 from ravh_sim.world import paints
+from ravh_sim.world.house import Light
 from ravh_sim.world.scene import World
 from ravh_sim.world.settings import Resolved, fit_model, knob_value, light_group, load_settings, resolve
 from ravh_sim.world.solids import model_count
@@ -44,6 +46,7 @@ SKY_NIGHT: RGB = (10, 14, 32)
 TWILIGHT_DEG = 15.0                       # how long after sunset (and before sunrise) light fades out
 SUN_SOUTH_TILT = 0.35                     # the sun's arc leans to -y so noon light is not vertical
 MOON_DIRECTION: RGB = (-0.3, 0.4, 0.87)
+HOUSE_KELVIN: float = Looks.model_fields["light_temperature"].default   # of the house files' light colours
 
 
 @dataclass(frozen=True)
@@ -75,6 +78,24 @@ def sun_light(angle: float) -> SunLight:
     sky = _lerp(SKY_NIGHT, _lerp(SKY_HORIZON, SKY_NOON, height), daylight)
     red, green, blue = (int(round(c)) for c in sky)
     return SunLight(a, direction, gain, (red, green, blue))
+
+
+def lamps_at(lights: Iterable[Light], kelvin: float) -> list[Light]:
+    """``lights`` at colour temperature ``kelvin``: each colour channel scales as a black body's does
+    from HOUSE_KELVIN to ``kelvin``, so at HOUSE_KELVIN every colour stays exactly as the house gives it."""
+    shift = tuple(a / b for a, b in zip(black_body(kelvin), black_body(HOUSE_KELVIN)))
+    return [replace(lt, color=(lt.color[0] * shift[0], lt.color[1] * shift[1], lt.color[2] * shift[2]))
+            for lt in lights]
+
+
+def black_body(kelvin: float) -> RGB:
+    """Linear-ish RGB (0..1) of a black body at ``kelvin`` (Tanner Helland's fit, 1000 K to 40000 K)."""
+    t = kelvin / 100.0
+    red = 255.0 if t <= 66 else 329.698727446 * (t - 60) ** -0.1332047592
+    green = 99.4708025861 * math.log(t) - 161.1195681661 if t <= 66 else 288.1221695283 * (t - 60) ** -0.0755148492
+    blue = 255.0 if t >= 66 else 0.0 if t <= 19 else 138.5177312231 * math.log(t - 10) - 305.0447927307
+    red, green, blue = (min(max(c, 0.0), 255.0) / 255.0 for c in (red, green, blue))
+    return (red, green, blue)
 
 
 class Appearance:
