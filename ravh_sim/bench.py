@@ -273,7 +273,7 @@ def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
                 continue
             if name.endswith("night_all_lights"):
                 appearance = Appearance(world)
-                appearance.set_sun("night")
+                appearance.set_knob("sun_angle", "night")
                 appearance.set_lights("all", "on")
             camera = SmartCamera(world, replace(profile.camera, quality=quality))
             camera.capture(*poses[0])                         # shadow maps and buffers are made once

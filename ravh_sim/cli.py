@@ -184,7 +184,7 @@ def cmd_render(args: argparse.Namespace) -> int:
     with World(house, resolved, renderer=resolve_backend(args.renderer)) as world:
         appearance = Appearance(world)
         if args.sun is not None:
-            appearance.set_sun(_sun_value(args.sun))
+            appearance.set_knob("sun_angle", _sun_value(args.sun))
         if args.lights is not None:
             appearance.set_lights("all", args.lights, args.seed)
         camera = SmartCamera(world, load_profile(args.profile).camera)

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -38,7 +37,7 @@ def test_laser_and_depth_agree_on_walls_objects_and_doors(houses, number):
     it; all doors closed."""
     house = houses[number]
     settings = resolve(load_settings(), house)
-    with World(house, replace(settings, doors=dict.fromkeys(settings.doors, False)),
+    with World(house, settings.changed(doors=dict.fromkeys(settings.doors, False)),
                renderer=resolve_backend("auto")) as world:
         camera, laser = SmartCamera(world, PROFILE.camera), Laser(world, PROFILE.laser)
         poses = [(house.station.position[0], house.station.position[1], house.station.yaw)]
@@ -79,7 +78,7 @@ def test_no_cracks_around_doors(houses, number):
     house = houses[number]
     settings = resolve(load_settings(), house)
     doors = {d.id: settings.doors[d.id] and len(d.rooms) == 2 for d in house.doors}
-    with World(house, replace(settings, doors=doors), renderer=resolve_backend("auto")) as world:
+    with World(house, settings.changed(doors=doors), renderer=resolve_backend("auto")) as world:
         camera = SmartCamera(world, PROFILE.camera)
         captures = 0
         for door in house.doors:

@@ -109,7 +109,7 @@ def test_round_trip(tmp_path, footprint20):
     assert len(ds) == 3
     assert ds.meta["format"] == layout.FORMAT and ds.meta["house"] == 20 and ds.meta["agents"] == ["robot"]
     assert ds.meta["raid"] == {"behaviour": "test"} and ds.meta["bag"] is None
-    assert ds.settings.to_dict() == footprint20["settings"]
+    assert ds.settings.model_dump(mode="json") == footprint20["settings"]
     assert json.loads((tmp_path / layout.SETTINGS_JSON).read_text()) == footprint20["settings"]
     assert ds.camera == {"robot": CAMERA}
     grid = ds.map

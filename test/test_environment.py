@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import json
-from dataclasses import replace
 
 import pytest
 from conftest import resolved
@@ -134,7 +133,7 @@ def test_object_pose_matches_chosen_model_box(houses, model):
     from ravh_sim.paths import HOUSES_DIR
     raw = next(o for o in json.loads((HOUSES_DIR / "house15.json").read_text())["objects"] if o["id"] == "Bed_0")
     settings = resolved(houses[15])
-    gt = GroundTruth(houses[15], WorldState(replace(settings, models={**settings.models, "Bed_0": model})))
+    gt = GroundTruth(houses[15], WorldState(settings.changed(models={**settings.models, "Bed_0": model})))
     result = gt.answer({"query": "object", "id": "Bed_0"})["result"]
     assert result["model"] == model
     assert result["position"] == pytest.approx(raw["models"][model]["position"], abs=1e-4)
@@ -154,7 +153,7 @@ def test_room_at_points_inside_each_room(gt15, houses):
 def test_connectivity_joins_every_room_with_doors_open(houses):
     for n in (15, 20, 23):
         settings = resolved(houses[n])
-        gt = GroundTruth(houses[n], WorldState(replace(settings, doors=dict.fromkeys(settings.doors, True))))
+        gt = GroundTruth(houses[n], WorldState(settings.changed(doors=dict.fromkeys(settings.doors, True))))
         comps = gt.answer({"query": "connectivity"})["result"]["components"]
         assert len(comps) == 1, (n, comps)
 
@@ -195,7 +194,7 @@ def test_instances_are_in_fixed_order(houses):
 
 def test_closing_every_door_splits_the_connectivity_graph(houses):
     settings = resolved(houses[15])
-    gt = GroundTruth(houses[15], WorldState(replace(settings, doors=dict.fromkeys(settings.doors, False))))
+    gt = GroundTruth(houses[15], WorldState(settings.changed(doors=dict.fromkeys(settings.doors, False))))
     comps = gt.answer({"query": "connectivity", "open_only": True})["result"]["components"]
     assert len(comps) == len(houses[15].rooms)        # house 15 has no door-less passages
 

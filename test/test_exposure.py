@@ -60,7 +60,7 @@ def test_random_views_are_exposed_plausibly(number):
         poses = _free_poses(world, POSES_PER_HOUSE, rng)
         start = 0
         for sun, share in SUNS:
-            appearance.set_sun(sun)
+            appearance.set_knob("sun_angle", sun)
             end = start + round(share * POSES_PER_HOUSE)
             for pose in poses[start:end]:
                 luma = _luma(camera.render(*pose).rgb)       # a NaN pixel raises RenderError
@@ -76,7 +76,7 @@ def black_view_world():
     number, _ = WAS_BLACK
     house = load_house(number)
     with World(house, resolve(load_settings(), house, 0), renderer=resolve_backend("auto")) as world:
-        Appearance(world).set_sun("day")
+        Appearance(world).set_knob("sun_angle", "day")
         yield world
 
 

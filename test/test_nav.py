@@ -509,7 +509,7 @@ def test_unreachable_names_only_the_doors_that_cut_the_way(houses):
     house = houses[20]
     settings = resolve(load_settings(), house, 0)
     doors = {**settings.doors, "Door_1": False, "Door_2": False}   # Door_2 is the bathroom's, not on the way
-    nav = Navigation(house, WorldState(dataclasses.replace(settings, doors=doors)), load_profile("giraff"))
+    nav = Navigation(house, WorldState(settings.changed(doors=doors)), load_profile("giraff"))
     goal = nav.room_goal("Bedroom_1")
     with pytest.raises(Unreachable) as err:
         nav.plan(house.station.position[:2], goal)
@@ -531,7 +531,7 @@ def test_navigation_rebuilds_its_maps_only_when_the_layout_changes(houses):
     from ravh_sim.world.state import WorldState
     house = houses[15]
     settings = resolve(load_settings(), house, 0)
-    state = WorldState(dataclasses.replace(settings, doors=dict.fromkeys(settings.doors, True)))
+    state = WorldState(settings.changed(doors=dict.fromkeys(settings.doors, True)))
     nav = Navigation(house, state, load_profile("giraff"))
     free, obstacle = nav.map(), nav.obstacle_map()
     state.write(sun_angle=200.0, paint={"Bedroom_1": {"walls": "brick"}})

@@ -62,7 +62,7 @@ VIEW_WEST = (5.8, 2.3, math.pi)
 
 
 def test_sunlight_through_the_window_makes_a_bright_floor_patch(world, appearance):
-    appearance.set_sun(AFTERNOON)
+    appearance.set_knob("sun_angle", AFTERNOON)
     appearance.set_lights("all", "off")
     camera = _camera(world)
     patch = _floor_hit(AFTERNOON, (-0.05, 2.0, 1.5))                 # the window's centre
@@ -79,7 +79,7 @@ def test_sunlight_through_the_window_makes_a_bright_floor_patch(world, appearanc
 def test_walls_and_ceiling_shadow_the_sun(world, appearance):
     """The same floor point under the afternoon sun: lit when shadows are off (fast quality),
     dark when the walls and ceiling are allowed to block the sun (realistic)."""
-    appearance.set_sun(AFTERNOON)
+    appearance.set_knob("sun_angle", AFTERNOON)
     appearance.set_lights("all", "off")
     point = _floor_hit(AFTERNOON, (-0.05, 2.0, 1.5)) + np.array([0.0, -1.6, 0.0])
     seen = {}
@@ -93,7 +93,7 @@ def test_walls_and_ceiling_shadow_the_sun(world, appearance):
 def test_sunset_moves_the_sun_and_colours_its_light_not_every_surface(world, appearance):
     noon, sunset = sun_light(100.0), sun_light(180.0)
     assert math.degrees(math.acos(np.dot(noon.direction, sunset.direction))) > 45
-    appearance.set_sun("sunset")
+    appearance.set_knob("sun_angle", "sunset")
     appearance.set_lights("all", "off")
     appearance.set_paint("A", "walls", "white")
     appearance.set_paint("A", "floor", "walnut")
@@ -109,7 +109,7 @@ def test_sunset_moves_the_sun_and_colours_its_light_not_every_surface(world, app
 
 
 def test_one_lamp_at_night_lights_near_more_than_far_without_halos(world, appearance):
-    appearance.set_sun("night")
+    appearance.set_knob("sun_angle", "night")
     appearance.set_lights("all", "off")
     appearance.set_light("Light_0", True)                            # over (3, 2)
     camera = _camera(world, options=CameraOptions(manual_exposure=3.0))
@@ -130,7 +130,7 @@ def test_one_lamp_at_night_lights_near_more_than_far_without_halos(world, appear
 
 
 def test_surfaces_carry_texture(world, appearance):
-    appearance.set_sun("day")
+    appearance.set_knob("sun_angle", "day")
     appearance.set_paint("A", "floor", "parquet")
     cap = _camera(world, options=CameraOptions()).capture(5.0, 2.0, math.pi)
     lum = _luminance(cap.rgb)
@@ -142,7 +142,7 @@ def test_surfaces_carry_texture(world, appearance):
 
 
 def test_rgb_depth_and_instance_edges_line_up(world, appearance):
-    appearance.set_sun("day")
+    appearance.set_knob("sun_angle", "day")
     cap = _camera(world, options=CameraOptions()).capture(2.0, 1.0, 0.25)      # the doorway to B
     inst = cap.instance.astype(np.int32)
     boundary = np.zeros(inst.shape, bool)

@@ -49,7 +49,7 @@ def make_world(houses, default_settings):
         house = houses[number]
         settings = resolve(default_settings, house)
         if agents is not None:
-            settings = dataclasses.replace(settings, agents=tuple(agents))
+            settings = settings.changed(agents=tuple(agents))
         world = World(house, settings, renderer="tiny")
         made.append(world)
         return world

@@ -110,7 +110,7 @@ def test_optical_frame_rotation_is_rep103():
 
 
 def test_appearance_requests_change_only_what_they_name(runtime):
-    before = runtime.world.state.settings().to_dict()
+    before = runtime.world.state.settings().model_dump(mode="json")
     reply = runtime.change_appearance({"doors": {"Door_1": "closed"}, "lights": {"ceiling": "off"}})
     assert reply["ok"], reply
     after = runtime.world.state
@@ -119,7 +119,7 @@ def test_appearance_requests_change_only_what_they_name(runtime):
     assert after.paint == before["paint"] and after.models == before["models"]
     assert runtime.map_version >= 1
     runtime.reset()
-    assert runtime.world.state.settings().to_dict() == runtime.initial.to_dict()
+    assert runtime.world.state.settings().model_dump(mode="json") == runtime.initial.model_dump(mode="json")
 
 
 def test_the_map_version_moves_with_doors_and_models_only(runtime):
@@ -141,10 +141,10 @@ def test_the_map_version_moves_with_doors_and_models_only(runtime):
     ({"paint": {"Bedroom_1": {"walls": "plaid"}}}, "bad_request"), ({"models": {"Bed_0": 99}}, "bad_request"),
 ])
 def test_bad_appearance_requests_get_structured_errors(runtime, request_, code):
-    before = runtime.world.state.settings().to_dict()
+    before = runtime.world.state.settings().model_dump(mode="json")
     reply = runtime.change_appearance(request_)
     assert reply["ok"] is False and reply["error"]["code"] == code
-    assert runtime.world.state.settings().to_dict() == before                 # nothing half-applied
+    assert runtime.world.state.settings().model_dump(mode="json") == before                 # nothing half-applied
 
 
 def test_appearance_syntax_is_checked_offline():

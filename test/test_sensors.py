@@ -430,7 +430,7 @@ def _mean(img, mask=None):
 def test_day_is_brighter_than_sunset_is_brighter_than_night(camera, appearance):
     means = {}
     for preset in ("day", "sunset", "night"):
-        appearance.set_sun(preset)
+        appearance.set_knob("sun_angle", preset)
         means[preset] = _mean(camera.capture(3.0, 2.0, math.pi).rgb)
     assert means["day"] > 1.2 * means["sunset"] > 1.2 * 1.5 * means["night"]
     assert sun_light(180).gain[0] > sun_light(180).gain[2]          # sunset light is warm
@@ -449,7 +449,7 @@ def test_the_robots_sensor_is_noisier_and_darker_at_night_and_the_ideal_camera_i
     noise, level = {}, {}
     try:
         for preset, lights in (("day", "on"), ("night", "on"), ("night", "off")):
-            appearance.set_sun(preset)
+            appearance.set_knob("sun_angle", preset)
             appearance.set_lights("all", lights)
             a, b = (real.capture(3.0, 2.0, math.pi).rgb.astype(np.float32) for _ in range(2))
             noise[preset + lights] = float(np.std(a - b)) / math.sqrt(2)
@@ -466,7 +466,7 @@ def test_lights_on_brighten_their_room_at_night_and_not_through_the_wall(world, 
     """With the exposure fixed (a camera in manual mode), a lamp brightens its own room and leaves
     the far side of the wall, seen from the next room with the door shut, exactly as it was."""
     camera = SmartCamera(world, PROFILE.camera, CameraOptions(manual_exposure=4.0))
-    appearance.set_sun("night")
+    appearance.set_knob("sun_angle", "night")
     appearance.set_lights("all", "off")
     appearance.set_door("Door_0", False)
     in_a, in_b = (3.0, 1.5, 0.0), (7.5, 3.3, math.pi)       # B looks west, at the wall it shares with A
@@ -536,7 +536,7 @@ def test_window_is_an_opening_onto_the_outdoors(world, appearance):
     window = world.instance("Wall_0").id
     seen = {}
     for preset in ("day", "night"):
-        appearance.set_sun(preset)
+        appearance.set_knob("sun_angle", preset)
         cap = camera.capture(3.0, 2.0, math.pi)
         pane = cap.instance == window
         assert pane.mean() > 0.03
@@ -649,4 +649,5 @@ def test_render_command_writes_images_and_info(tmp_path, capsys):
     top = info["instances"][0]
     assert (mask[:, :, ::-1].reshape(-1, 3) == top["mask_color"]).all(axis=1).sum() == top["pixels"]
     assert main(["render", "15", "--pose", "0", "0", "0", "--sun", "noon", "-o", str(out)]) == 2
-    assert "sun preset" in capsys.readouterr().err
+    assert "sun_angle: expected degrees in [0, 360] or one of day, sunset, night, random, got 'noon'" \
+        in capsys.readouterr().err

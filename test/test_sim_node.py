@@ -423,8 +423,9 @@ def test_qos_offered_follows_rep_2003(sim):
 
 
 def test_oversized_requests_are_refused_and_not_kept(sim):
-    """10 MB requests are refused by their length; the sim keeps no copy of them (its memory after six
-    is what it was after two), and what stays is bounded (DDS buffers, not requests)."""
+    """10 MB requests are refused by their length; the sim keeps no copy of them (eight more after the
+    first two add less than two of them would: its allocator and renders move RSS by a few MB on their
+    own), and what stays is bounded (DDS buffers, not requests)."""
     proc, probe = sim
 
     def rss_mb() -> float:
@@ -434,15 +435,15 @@ def test_oversized_requests_are_refused_and_not_kept(sim):
     big = "x" * 10_000_000
     before = rss_mb()
     replies, after_two = [], 0.0
-    for k in range(6):
+    for k in range(10):
         service = n.QUERY_SERVICE if k % 2 == 0 else n.APPEARANCE_SERVICE
         replies.append(probe.call(AddDiagnostics, service, AddDiagnostics.Request(load_namespace=big), timeout=60))
         if k == 1:
             after_two = rss_mb()
-    after_six = rss_mb()
+    after_ten = rss_mb()
     assert all(not r.success and "over the limit" in r.message and len(r.message) < 1000 for r in replies)
-    assert after_six - after_two < 5, (before, after_two, after_six)
-    assert after_six - before < 40, (before, after_two, after_six)
+    assert after_ten - after_two < 2 * len(big) / 1e6, (before, after_two, after_ten)
+    assert after_ten - before < 40, (before, after_two, after_ten)
     assert proc.alive()
 
 

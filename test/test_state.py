@@ -2,12 +2,12 @@
 revisions that tell readers what changed, and a footprint that follows the state."""
 from __future__ import annotations
 
-import dataclasses
 import re
 from pathlib import Path
 
 import pytest
 from conftest import ROOT, resolved
+from pydantic import ValidationError
 
 from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import make_footprint
@@ -40,7 +40,7 @@ def _revisions(world: World) -> tuple[int, int]:
 def test_resolved_settings_cannot_be_changed(houses):
     settings = resolved(houses[15])
     door = next(iter(settings.doors))
-    with pytest.raises(dataclasses.FrozenInstanceError):
+    with pytest.raises(ValidationError):                      # frozen
         settings.sun_angle = 3.0
     with pytest.raises(TypeError):
         settings.doors[door] = not settings.doors[door]
@@ -56,8 +56,8 @@ def test_resolved_keeps_its_own_copy_and_round_trips():
                         models={})
     doors["Door_0"] = False                                   # the caller's dict is not the record
     assert settings.doors["Door_0"] is True
-    assert Resolved.from_dict(settings.to_dict()) == settings
-    closed = dataclasses.replace(settings, doors={"Door_0": False})
+    assert Resolved.model_validate(settings.model_dump(mode="json")) == settings
+    closed = settings.changed(doors={"Door_0": False})
     assert closed.doors["Door_0"] is False and settings.doors["Door_0"] is True
 
 
@@ -86,7 +86,7 @@ def test_every_appearance_change_bumps_the_revision_and_only_layout_the_layout_r
     door = world.house.doors[0].id
     light = world.house.lights[0].id
     changes = [  # (change, does it move doors or models?)
-        (lambda: appearance.set_sun(33.0), False),
+        (lambda: appearance.set_knob("sun_angle", 33.0), False),
         (lambda: appearance.set_light(light, not world.state.lights[light]), False),
         (lambda: appearance.set_lights("all", "off"), False),
         (lambda: appearance.set_paint("Bedroom_1", "walls", "brick"), False),
@@ -106,21 +106,23 @@ def test_every_appearance_change_bumps_the_revision_and_only_layout_the_layout_r
 def test_a_change_to_what_already_is_changes_no_revision(world, appearance):
     door = world.house.doors[0].id
     before = _revisions(world)
-    appearance.set_sun(world.state.sun_angle)
+    appearance.set_knob("sun_angle", world.state.sun_angle)
     appearance.set_door(door, world.state.doors[door])
     appearance.apply(world.state.settings())
     assert _revisions(world) == before
 
 
-def test_the_renderer_revision_follows_body_changes_only(world, appearance):
-    """``World.revision`` (what the GL renderer rebuilds its geometry on) moves with doors, models and
-    paint; the sun and the lights are compared by the renderer itself."""
-    before = world.revision
-    appearance.set_sun("night")
-    appearance.set_lights("all", "on")
-    assert world.revision == before
+def test_readers_are_told_which_fields_changed(world, appearance):
+    """What the GL renderer redraws by: the fields whose revision moved since it last looked."""
+    light = world.house.lights[0].id
+    seen = world.state.revisions()
+    appearance.set_knob("sun_angle", 33.0)
+    appearance.set_light(light, not world.state.lights[light])
+    assert world.state.changed_since(seen) == {"sun_angle", "lights"}
     appearance.set_paint("Bedroom_1", "walls", "brick")
-    assert world.revision > before
+    assert world.state.changed_since(seen) == {"sun_angle", "lights", "paint"}
+    assert world.state.changed_since(world.state.revisions()) == frozenset()
+    assert world.state.changed_since(None) == set(world.state.revisions())
 
 
 def test_the_footprint_follows_the_live_state(world, appearance):

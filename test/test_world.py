@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 import pybullet as pb
@@ -103,7 +102,7 @@ def test_every_variant_of_every_object_lies_in_its_footprint_box(houses):
         settings = resolved(house)
         for variant in range(max(model_count(o) for o in house.objects)):
             models = {o.id: variant for o in house.objects}
-            rows = {r["name"]: r for r in make_footprint(house, replace(settings, models=models))["instances"]}
+            rows = {r["name"]: r for r in make_footprint(house, settings.changed(models=models))["instances"]}
             for obj in house.objects:
                 row, placed = rows[obj.id], object_parts(house, obj, variant)
                 if obj.id in house.door_by_id:

@@ -149,7 +149,7 @@ class Dataset:
 
     @cached_property
     def settings(self) -> Resolved:
-        return Resolved.from_dict(self.footprint["settings"])
+        return Resolved.model_validate(self.footprint["settings"])
 
     @cached_property
     def map(self) -> Grid | None:

@@ -39,7 +39,7 @@ def walkable_of(footprint: dict[str, Any], profile: RobotProfile) -> Grid:
     from ravh_sim.world.settings import Resolved
     from ravh_sim.world.state import WorldState
     house = load_house(int(footprint["house"]))
-    state = WorldState(Resolved.from_dict(footprint["settings"]))
+    state = WorldState(Resolved.model_validate(footprint["settings"]))
     return Navigation(house, state, profile).walkable(PAPER_AGENT_RADIUS)
 
 

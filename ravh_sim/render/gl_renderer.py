@@ -32,7 +32,7 @@ from ravh_sim.render.geometry import ATTRIBUTES, VERTEX_FORMAT, SceneBuilder
 from ravh_sim.render.materials import NOISE_TEXELS, PATTERN, TEXELS, MaterialTable, noise_volume, srgb8_to_linear
 from ravh_sim.render.projection import look_at, orthographic, perspective, projection_from_K, view_matrix
 from ravh_sim.render.views import RenderedViews
-from ravh_sim.world.appearance import SunLight, sun_light
+from ravh_sim.world.appearance import SunLight, lamps_at, sun_light
 from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import Light
 from ravh_sim.world.scene import World
@@ -80,6 +80,10 @@ CENTRE_WEIGHT = 3.0                   # metering weight of the frame's middle ag
 CENTRE_SPREAD = 0.25                  # sigma of the centre weight, in frame widths and heights
 METER_HIGHLIGHT = math.log(4.0)       # metering counts a block at most 2 stops above the median
 METER_BLOCK = 16                      # pixels per side averaged by one metering texel
+# Fields of the world state (ravh_msgs_py.appearance.Looks) that _sync redraws for: geometry redoes
+# everything, lighting the light state and the light maps.
+GEOMETRY_FIELDS = frozenset({"doors", "models", "paint"})
+LIGHTING_FIELDS = frozenset({"sun_angle", "lights", "light_temperature"})
 
 
 class RenderError(RuntimeError):
@@ -244,8 +248,7 @@ class GLRenderer:
         self._library_layers: list[str] | None = None
         self.vaos: dict[str, moderngl.VertexArray] = {}
         self._room_vaos: dict[str, tuple[moderngl.VertexArray, moderngl.VertexArray, moderngl.Buffer]] = {}
-        self._geometry_revision = -1
-        self._sun_angle: float | None = None
+        self._synced: dict[str, int] | None = None        # the state's field revisions at the last _sync
         self._lights_on: frozenset[str] | None = None
         self._shadowed: set[str] = set()                  # lights whose cube map is current
         self._light_row = {lt.id: row for row, lt in enumerate(world.house.lights)}
@@ -270,26 +273,30 @@ class GLRenderer:
     # ------------------------------------------------------------------ scene state
     def _sync(self) -> None:
         """Bring GPU geometry, light state and the light maps up to date with the World, redoing
-        only what a change touches: a new geometry revision (door, model, paint) redoes everything,
-        a new sun angle its shadow map and every probe, a switched light its own cube map and the
-        probes of the rooms it reaches."""
+        only what the fields the state says changed touch: geometry (doors, models, paint) redoes
+        everything, the sun angle its shadow map and every probe, a switched light its own cube map
+        and the probes of the rooms it reaches."""
         world = self.world
-        if world.revision != self._geometry_revision:
+        changed = world.state.changed_since(self._synced)
+        self._synced = world.state.revisions()
+        if changed & GEOMETRY_FIELDS:
             self._upload_geometry()
-            self._geometry_revision = world.revision
             self._render_coverage()
-            self._lights_on, self._sun_angle = None, None
+            self._lights_on = None
             self._shadowed.clear()
-        on = frozenset(k for k, v in world.state.lights.items() if v)
-        sun_changed = world.state.sun_angle != self._sun_angle
-        if not sun_changed and on == self._lights_on:
+            changed |= {"sun_angle"}
+        if not changed & LIGHTING_FIELDS:
             return
+        if "light_temperature" in changed:
+            self._lights_on = None                # every light's colour moved: relight every room
+        sun_changed = "sun_angle" in changed
+        on = frozenset(k for k, v in world.state.lights.items() if v)
         switched = on ^ self._lights_on if self._lights_on is not None else None
         sun = sun_light(world.state.sun_angle)
-        lights = [lt for lt in world.house.lights if lt.id in on]
+        lights = lamps_at([lt for lt in world.house.lights if lt.id in on], world.state.settings().light_temperature)
         self._upload_instances(sun, lights)
         self._set_lighting(sun, lights)
-        self._sun_angle, self._lights_on = world.state.sun_angle, on
+        self._lights_on = on
         if not self.shadows:
             return
         if sun_changed:

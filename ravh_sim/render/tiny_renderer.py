@@ -14,7 +14,7 @@ import pybullet as pb
 from ravh_sim.render.projection import projection_from_K, view_matrix
 from ravh_sim.render.tiny_lighting import SUN_AMBIENT, SUN_DIFFUSE, Lighting
 from ravh_sim.render.views import RenderedViews
-from ravh_sim.world.appearance import sun_light
+from ravh_sim.world.appearance import lamps_at, sun_light
 from ravh_sim.world.scene import World
 
 SAMPLE_OFFSET = (0.0, 1.0)        # where TinyRenderer samples pixel (u, v), measured against K
@@ -50,7 +50,8 @@ class TinyRenderer:
         depth[background | (buffer >= 1.0)] = np.nan
         lut = np.append(self.world.body_to_instance_lut(), 0).astype(np.uint16)  # seg -1 -> last entry
         instance = np.take(lut, seg, mode="wrap")
-        lights = [lt for lt in self.world.house.lights if state.lights.get(lt.id, False)]
+        lights = lamps_at([lt for lt in self.world.house.lights if state.lights.get(lt.id, False)],
+                          state.settings().light_temperature)
         rgb = self.lighting.apply(cv2.cvtColor(rgba, cv2.COLOR_RGBA2RGB), depth, instance, rotation,
                                   position, sun, lights)
         if background.any():

@@ -4,29 +4,32 @@
 :mod:`ravh_sim.world.state`): the CLI, the benchmarks, the gallery and the ROS appearance service
 (:meth:`Appearance.change`, which speaks the request language of :mod:`ravh_msgs_py.appearance`) all
 change a world through it, so the footprint always describes what the sensors see. Paint, models and
-doors change pybullet bodies (through the World's primitives, no rebuild); the sun and the lights are
-read by the camera at capture time, so switching them costs nothing. Random choices go through
+doors change pybullet bodies (through the World's primitives, no rebuild); the global knobs (the sun
+angle, :data:`ravh_msgs_py.appearance.KNOBS`) and the lights are read by the camera at capture time, so
+switching them costs nothing. Random choices go through
 :func:`settings.resolve`, so "random" here picks exactly what the same seed picks in a settings file.
 
 The sun model (:func:`sun_light`) is here too: one angle gives the light direction, the colour and
-level of daylight indoors and the sky colour seen beyond the house and through the windows.
+level of daylight indoors and the sky colour seen beyond the house and through the windows; and the
+lamp model (:func:`lamps_at`): the lights' colours at a colour temperature.
 """
 from __future__ import annotations
 
 import contextlib
 import copy
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Any
 
-from ravh_msgs_py.appearance import LIGHT_GROUPS, SUN_PRESETS, SURFACES, SWITCH
+from ravh_msgs_py.appearance import KNOBS, LIGHT_GROUPS, SURFACES, SWITCH, Looks
 from ravh_msgs_py.query import UNKNOWN_ID, QueryError
 from ravh_sim.errors import UnknownNameError, UserError
 from ravh_sim.world import paints
+from ravh_sim.world.house import Light
 from ravh_sim.world.scene import World
-from ravh_sim.world.settings import Resolved, fit_model, light_group, load_settings, resolve
+from ravh_sim.world.settings import Resolved, fit_model, knob_value, light_group, load_settings, resolve
 from ravh_sim.world.solids import model_count
 
 RGB = tuple[float, float, float]
@@ -43,6 +46,7 @@ SKY_NIGHT: RGB = (10, 14, 32)
 TWILIGHT_DEG = 15.0                       # how long after sunset (and before sunrise) light fades out
 SUN_SOUTH_TILT = 0.35                     # the sun's arc leans to -y so noon light is not vertical
 MOON_DIRECTION: RGB = (-0.3, 0.4, 0.87)
+HOUSE_KELVIN: float = Looks.model_fields["light_temperature"].default   # of the house files' light colours
 
 
 @dataclass(frozen=True)
@@ -76,6 +80,24 @@ def sun_light(angle: float) -> SunLight:
     return SunLight(a, direction, gain, (red, green, blue))
 
 
+def lamps_at(lights: Iterable[Light], kelvin: float) -> list[Light]:
+    """``lights`` at colour temperature ``kelvin``: each colour channel scales as a black body's does
+    from HOUSE_KELVIN to ``kelvin``, so at HOUSE_KELVIN every colour stays exactly as the house gives it."""
+    shift = tuple(a / b for a, b in zip(black_body(kelvin), black_body(HOUSE_KELVIN)))
+    return [replace(lt, color=(lt.color[0] * shift[0], lt.color[1] * shift[1], lt.color[2] * shift[2]))
+            for lt in lights]
+
+
+def black_body(kelvin: float) -> RGB:
+    """Linear-ish RGB (0..1) of a black body at ``kelvin`` (Tanner Helland's fit, 1000 K to 40000 K)."""
+    t = kelvin / 100.0
+    red = 255.0 if t <= 66 else 329.698727446 * (t - 60) ** -0.1332047592
+    green = 99.4708025861 * math.log(t) - 161.1195681661 if t <= 66 else 288.1221695283 * (t - 60) ** -0.0755148492
+    blue = 255.0 if t >= 66 else 0.0 if t <= 19 else 138.5177312231 * math.log(t - 10) - 305.0447927307
+    red, green, blue = (min(max(c, 0.0), 255.0) / 255.0 for c in (red, green, blue))
+    return (red, green, blue)
+
+
 class Appearance:
     """Run-time changes to how a house looks: the only writer of ``world.state``'s appearance."""
 
@@ -84,20 +106,15 @@ class Appearance:
         self.house = world.house
         self.state = world.state
 
-    # ------------------------------------------------------------------ sun and lights
+    # ------------------------------------------------------------------ global knobs and lights
     @property
     def sun(self) -> SunLight:
         return sun_light(self.state.sun_angle)
 
-    def set_sun(self, angle: float | str) -> None:
-        """Sun angle in degrees [0, 360] or a preset name (day, sunset, night)."""
-        if isinstance(angle, str):
-            if angle not in SUN_PRESETS:
-                raise UnknownNameError("sun preset", angle, list(SUN_PRESETS))
-            angle = SUN_PRESETS[angle]
-        if not (isinstance(angle, (int, float)) and math.isfinite(angle) and 0.0 <= angle <= 360.0):
-            raise UserError(f"sun angle must be degrees in [0, 360], got {angle!r}")
-        self.state.write(sun_angle=float(angle))
+    def set_knob(self, name: str, choice: float | str, seed: int | None = None) -> None:
+        """Set a global knob (KNOBS: "sun_angle", ...) to a number in its range or one of its words
+        ("night"; "random" draws with ``seed``, by default the world's)."""
+        self.state.write(**{name: knob_value(name, choice, self.state.seed if seed is None else seed)})
 
     def set_light(self, light_id: str, on: bool) -> None:
         if light_id not in self.house.light_by_id:
@@ -164,18 +181,17 @@ class Appearance:
         self.check(target)
         before = self.state.settings()
         try:
-            self._bring(target.sun_angle, target.lights, target.doors, target.paint, target.models)
+            self._bring(target)
         except BaseException:
             with contextlib.suppress(Exception):      # the first error is the one to report
-                self._bring(before.sun_angle, before.lights, before.doors, before.paint, before.models)
+                self._bring(before)
             raise
 
     def check(self, target: Resolved) -> None:
-        """Refuse (UserError) a target this world cannot show: an unknown item, a sun angle out of
-        range, an unknown paint, a model index an object does not have. Moves nothing."""
+        """Refuse (UserError) a target this world cannot show: an unknown item, an unknown paint, a
+        model index an object does not have (the model's own bounds, like the sun angle's range, held
+        when ``target`` was made). Moves nothing."""
         house, state = self.house, self.state
-        if not (math.isfinite(target.sun_angle) and 0.0 <= target.sun_angle <= 360.0):
-            raise UserError(f"sun angle must be degrees in [0, 360], got {target.sun_angle!r}")
         for kind, items, known in (("light", target.lights, state.lights), ("door", target.doors, state.doors),
                                    ("room", target.paint, state.paint), ("object", target.models, state.models)):
             for item in items:
@@ -211,9 +227,9 @@ class Appearance:
         resolved like a settings file (same seed rules) before anything changes (:meth:`apply`); only
         the items the request names change."""
         if "randomise" in request:
-            return {"settings": self.randomise(int(request["randomise"])).to_dict()}
+            return {"settings": self.randomise(int(request["randomise"])).model_dump(mode="json")}
         self.apply(self.target(request))
-        return {"settings": self.state.settings().to_dict()}
+        return {"settings": self.state.settings().model_dump(mode="json")}
 
     def target(self, request: dict[str, Any]) -> Resolved:
         """The settings a parsed appearance request asks for: the current ones with the items it names
@@ -236,16 +252,16 @@ class Appearance:
                     models[o] = model
         overrides: dict[str, dict[str, Any]] = {"lights": {"set": lights}, "doors": {"set": doors},
                                                 "paint": {"rooms": rooms}, "models": {"set": models}}
-        if "sun_angle" in request:
-            overrides["lights"]["sun_angle"] = request["sun_angle"]
+        knobs = [name for name in KNOBS if name in request]
+        overrides["lights"].update({name: request[name] for name in knobs})
         picked = self._resolve(overrides, request.get("seed"), "appearance request")
         chosen_models = {o: picked.models[o] for o in models}
         for obj, source in inherit.items():
             chosen = chosen_models.get(source, self.state.models[source])
             chosen_models[obj] = fit_model(chosen, self.house.object(obj))
         now = self.state.settings()
-        target = replace(
-            now, sun_angle=picked.sun_angle if "sun_angle" in request else now.sun_angle,
+        target = now.changed(
+            **{name: getattr(picked, name) for name in knobs},
             lights={**now.lights, **{lid: picked.lights[lid] for lid in lights}},
             doors={**now.doors, **{d: picked.doors[d] for d in doors}},
             paint={r: {**s, **{k: picked.paint[r][k] for k in rooms.get(r, {})}} for r, s in now.paint.items()},
@@ -253,12 +269,12 @@ class Appearance:
         self.check(target)
         return target
 
-    def _bring(self, sun_angle: float | None, lights: Mapping[str, bool], doors: Mapping[str, bool],
-               paint: Mapping[str, Mapping[str, str]], models: Mapping[str, int]) -> None:
-        """Change the items given that differ, in the house's order (sun, lights, doors, paint, models)."""
+    def _bring(self, target: Resolved) -> None:
+        """Change the items of ``target`` that differ, in the house's order (knobs, lights, doors, paint,
+        models)."""
         state = self.state
-        if sun_angle is not None and sun_angle != state.sun_angle:
-            self.set_sun(sun_angle)
+        state.write(**{name: getattr(target, name) for name in KNOBS})
+        lights, doors, paint, models = target.lights, target.doors, target.paint, target.models
         for lid in state.lights:
             if lid in lights and lights[lid] != state.lights[lid]:
                 self.set_light(lid, lights[lid])

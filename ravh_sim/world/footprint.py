@@ -96,7 +96,7 @@ def make_footprint(house: House, settings: Resolved) -> dict[str, Any]:
         if inst.name in settings.lights:
             row["on"] = settings.lights[inst.name]
         rows.append(row)
-    return {"format": FOOTPRINT_FORMAT, "house": house.number, "settings": settings.to_dict(),
+    return {"format": FOOTPRINT_FORMAT, "house": house.number, "settings": settings.model_dump(mode="json"),
             "instances": rows}
 
 
@@ -122,7 +122,7 @@ def load_footprint(path: Path) -> tuple[int, Resolved]:
     if not isinstance(data, dict) or data.get("format") != FOOTPRINT_FORMAT:
         raise FileFieldError(path, "format", f"expected {FOOTPRINT_FORMAT!r}")
     try:
-        return int(data["house"]), Resolved.from_dict(data["settings"])
+        return int(data["house"]), Resolved.model_validate(data["settings"])
     except (KeyError, TypeError, ValueError) as e:
         raise FileFieldError(path, f"settings ({e})", "missing or malformed") from None
 

@@ -9,9 +9,9 @@ The World owns the live :class:`~ravh_sim.world.state.WorldState` (:attr:`World.
 the settings) but does not write it: :class:`ravh_sim.world.appearance.Appearance` does, moving bodies
 through the primitives here (:meth:`World.place_door`, :meth:`World.load_model`, :meth:`World.repaint`).
 
-It also keeps what every body looks like (:attr:`World.visuals`: the mesh, its paint) and a
-:attr:`World.revision` that grows with every change to them (doors, models, paint), so a renderer
-(ravh_sim.render) can rebuild its GPU copy of the house only when one happened. pybullet's own renderer is used only
+It also keeps what every body looks like (:attr:`World.visuals`: the mesh, its paint); a renderer
+(ravh_sim.render) rebuilds its GPU copy of the house only when the state says doors, models or paint
+changed (:meth:`WorldState.changed_since`). pybullet's own renderer is used only
 by the TinyRenderer fallback; the EGL plugin is never loaded (one GL context per process belongs to
 ravh_sim.render). The World sits below its renderers: whoever builds it picks the backend
 (:func:`ravh_sim.render.backend.resolve_backend`) and tells it which one will draw it.
@@ -85,7 +85,6 @@ class World:
         self._pybullet_draws = self.renderer == "tiny"        # else pybullet bodies need no visual shape
         self.client = connect()
         self.visuals: dict[int, Visual] = {}     # pybullet body -> what it looks like
-        self.revision = 0                          # grows with every change to a body's look or place
         pb.setGravity(0, 0, -9.81, physicsClientId=self.client)
         pb.setTimeStep(1.0 / physics_hz, physicsClientId=self.client)
         self._assets = cache_dir()
@@ -291,7 +290,6 @@ class World:
 
     def _apply_paint(self, body: int, paint: str) -> None:
         self.visuals[body].paint = paint
-        self.revision += 1
         if not self._pybullet_draws:
             return
         if paints.is_texture(paint):
@@ -319,7 +317,6 @@ class World:
         (x, y, z), yaw = door_pose(self.house, self.house.door_by_id[door_id])
         pb.resetBasePositionAndOrientation(self._by_name[door_id].body, [x, y, z - OPEN_DOOR_DROP * is_open],
                                            quaternion_from_yaw(yaw), physicsClientId=self.client)
-        self.revision += 1
 
     def load_model(self, object_id: str, model: int) -> None:
         """Replace an object's body by model variant ``model`` (visual and collision); a door's new
@@ -338,7 +335,6 @@ class World:
         else:
             inst.body = self._object_body(self.house.object(object_id), model)
         self._models_now[object_id] = model
-        self.revision += 1
         if inst.kind == "door":
             self.place_door(object_id, self.state.doors[object_id])
 

@@ -5,23 +5,23 @@ ceiling light on", "random paint", "door Door_2 closed"); :func:`resolve` turns 
 :class:`Resolved` value with one explicit choice per light, door, room and object. Every random choice
 comes from the single seed, drawn per item from a stream named after the item, so changing one item's
 setting never reshuffles the others, and the same seed and file always give the same world.
-The resolved settings are frozen: a World starts from them, and its live state
-(:mod:`ravh_sim.world.state`) is the current :class:`Resolved` value, replaced on each change. That
-value goes into the footprint, and a footprint rebuilds the world from it alone.
+The resolved settings are the appearance model (:class:`ravh_msgs_py.appearance.Looks`, whose
+global knobs, like the sun angle, this file's ``lights`` section sets) with the seed and the agents:
+frozen, a World starts from them, and its live state (:mod:`ravh_sim.world.state`) is the current
+:class:`Resolved` value, replaced on each change. That value goes into the footprint, and a footprint
+rebuilds the world from it alone.
 """
 from __future__ import annotations
 
 import math
 import random
-from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from types import MappingProxyType
 from typing import Annotated, Any
 
-from pydantic import AfterValidator, Field
+from pydantic import AfterValidator, Field, create_model
 
-from ravh_msgs_py.appearance import DOOR, SEED_MAX, SUN_PRESETS, SWITCH
+from ravh_msgs_py.appearance import DOOR, KNOBS, SEED_MAX, SWITCH, Looks, Seed
 from ravh_msgs_py.names import DEFAULT_PROFILE
 from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
 from ravh_sim.paths import DEFAULT_CONFIG, ROBOTS_DIR
@@ -38,13 +38,6 @@ RESERVED_AGENT_NAMES = ("ravh",)   # a second agent's names are prefixed with it
 
 # --------------------------------------------------------------------------- the file's schema
 # Values that mix words and numbers get one validator each, so an error says what is allowed.
-
-def _check_sun(v: Any) -> Any:
-    if v in (*SUN_PRESETS, "random") or isinstance(v, (int, float)) and not isinstance(v, bool) \
-            and math.isfinite(v) and 0 <= v <= 360:
-        return v
-    raise ValueError("expected degrees in [0, 360], day, sunset, night or random")
-
 
 def _check_switch(v: Any) -> Any:
     if isinstance(v, bool) or v in SWITCH:  # YAML 1.1 reads on/off as booleans
@@ -83,11 +76,16 @@ def _checked(check) -> Any:
     return Annotated[Any, AfterValidator(check)]
 
 
-class _Lights(Strict):
-    sun_angle: _checked(_check_sun)
+class _Switches(Strict):
     ceiling: _checked(_check_switch)
     lamps: _checked(_check_switch)
     set: dict[str, _checked(_check_switch)]
+
+
+# the lights section: the switches and every global knob of the appearance model (sun_angle, ...)
+_KNOB_FIELDS: dict[str, Any] = {name: (_checked(knob.check), Looks.model_fields[name].default)
+                                for name, knob in KNOBS.items()}
+_Lights = create_model("_Lights", __base__=_Switches, **_KNOB_FIELDS)
 
 
 class _Doors(Strict):
@@ -121,7 +119,7 @@ class _Agent(Strict):
 
 class SettingsFile(Strict):
     """Every key of a settings file after merging over the defaults (config/default.yaml)."""
-    seed: Annotated[int, Field(ge=0, le=SEED_MAX)]
+    seed: Seed
     lights: _Lights
     doors: _Doors
     paint: _Paint
@@ -143,45 +141,23 @@ class AgentSpec:
     pose: tuple[float, float, float]         # x, y, yaw in the house frame
 
 
-@dataclass(frozen=True)
-class Resolved:
-    """One explicit choice for every item: what a world is built from and what a footprint stores.
-
-    Frozen, mappings included (read-only views of private copies): a value that was handed to a World
-    or written into a footprint can never drift from what it recorded. Use ``dataclasses.replace`` to
-    derive another."""
-    seed: int
-    sun_angle: float
-    lights: Mapping[str, bool]
-    doors: Mapping[str, bool]                # door id -> open
-    paint: Mapping[str, Mapping[str, str]]   # room id -> {"walls": paint, "floor": paint}
-    models: Mapping[str, int]                # object id -> model variant
+class Resolved(Looks):
+    """One explicit choice for every item: what a world is built from and what a footprint stores
+    (``model_dump(mode="json")``; ``model_validate`` reads it back). Frozen, mappings included: a value
+    that was handed to a World or written into a footprint can never drift from what it recorded;
+    :meth:`changed` derives another."""
+    seed: Seed
     agents: tuple[AgentSpec, ...] = ()
 
-    def __post_init__(self) -> None:
-        frozen = {"lights": MappingProxyType(dict(self.lights)), "doors": MappingProxyType(dict(self.doors)),
-                  "paint": MappingProxyType({room: MappingProxyType(dict(surfaces))
-                                             for room, surfaces in self.paint.items()}),
-                  "models": MappingProxyType(dict(self.models)), "agents": tuple(self.agents)}
-        for name, value in frozen.items():
-            object.__setattr__(self, name, value)
 
-    def to_dict(self) -> dict[str, Any]:
-        return {"seed": self.seed, "sun_angle": self.sun_angle, "lights": dict(self.lights),
-                "doors": dict(self.doors), "paint": {room: dict(s) for room, s in self.paint.items()},
-                "models": dict(self.models),
-                "agents": [{"name": a.name, "profile": a.profile, "pose": list(a.pose)} for a in self.agents]}
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> Resolved:
-        agents = tuple(AgentSpec(a["name"], a["profile"], _pose(a["pose"])) for a in d.get("agents", []))
-        return cls(seed=int(d["seed"]), sun_angle=float(d["sun_angle"]), lights=d["lights"], doors=d["doors"],
-                   paint=d["paint"], models={k: int(v) for k, v in d["models"].items()}, agents=agents)
-
-
-def _pose(values: Any) -> tuple[float, float, float]:
-    x, y, yaw = values
-    return (x, y, yaw)
+def knob_value(name: str, choice: Any, seed: int) -> float:
+    """The value of global knob ``name`` (ravh_msgs_py.appearance.KNOBS) that ``choice`` (a number or
+    one of the knob's words) stands for; "random" draws from ``seed`` as a settings file does."""
+    knob = KNOBS[name]
+    try:
+        return knob.value(knob.check(choice), _Picker(seed).stream)
+    except ValueError as e:
+        raise UserError(f"{name}: {e}, got {shown(choice)}") from None
 
 
 def light_group(light: Light) -> str:
@@ -210,7 +186,8 @@ def resolve(settings: dict[str, Any], house: House, seed: int | None = None,
     paint_cfg, models_cfg = settings["paint"], settings["models"]
     return Resolved(
         seed=seed,
-        sun_angle=_sun_angle(lights_cfg.get("sun_angle", "day"), pick, source),
+        **{name: knob.value(lights_cfg.get(name, Looks.model_fields[name].default), pick.stream)
+           for name, knob in KNOBS.items()},
         lights=_resolve_lights(lights_cfg, house, pick, source),
         doors=_resolve_doors(doors_cfg, house, pick, source),
         paint=_resolve_paint(paint_cfg, house, pick, source),
@@ -225,19 +202,14 @@ class _Picker:
     def __init__(self, seed: int) -> None:
         self.seed = seed
 
+    def stream(self, name: str) -> random.Random:
+        return random.Random(f"{self.seed}/{name}")
+
     def rng(self, what: str, item: str) -> random.Random:
-        return random.Random(f"{self.seed}/{what}/{item}")
+        return self.stream(f"{what}/{item}")
 
     def coin(self, what: str, item: str) -> bool:
         return self.rng(what, item).random() < 0.5
-
-
-def _sun_angle(value: Any, pick: _Picker, source: str) -> float:
-    if isinstance(value, str) and value in SUN_PRESETS:
-        return SUN_PRESETS[value]
-    if value == "random":
-        return pick.rng("sun", "angle").uniform(0.0, 240.0)
-    return float(_check_sun(value))
 
 
 def _switch(value: Any) -> str:

@@ -4,29 +4,28 @@ A World starts from frozen :class:`~ravh_sim.world.settings.Resolved` settings a
 later here. Everyone reads it (as read-only mappings); one place writes it:
 :class:`ravh_sim.world.appearance.Appearance` (the Simulation records, once, where its robots really
 start). The state is the world's current :class:`Resolved` value, replaced (never edited) on each
-change, so :meth:`WorldState.settings` is the footprint's record of it at no cost, and two counters let
-readers cache instead of comparing: ``revision`` grows with every change, ``layout_revision`` only
-when a door or an object model changes (what maps and plans depend on).
+change, so :meth:`WorldState.settings` is the footprint's record of it at no cost. Each field of the
+model has a revision that grows when the field changes, so readers cache instead of comparing: a
+renderer asks :meth:`WorldState.changed_since` which fields moved since it last looked, and
+``layout_revision`` grows only when a door or an object model changes (what maps and plans depend on).
 """
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from dataclasses import replace
-from typing import TypeVar
+from collections.abc import Mapping
+from typing import Any
 
 from ravh_sim.world.settings import AgentSpec, Resolved
 
-V = TypeVar("V")
+LAYOUT_FIELDS = ("doors", "models")
 
 
 class WorldState:
     """Sun angle, lights, doors, paint, models and agents of one world as they are now: the current
-    frozen settings and two revision counters."""
+    frozen settings and a revision per field."""
 
     def __init__(self, initial: Resolved) -> None:
         self._now = initial
-        self._revision = 0
-        self._layout_revision = 0
+        self._revisions = dict.fromkeys(Resolved.model_fields, 0)
 
     def settings(self) -> Resolved:
         """The state as frozen settings: what a footprint records and a world is rebuilt from. A later
@@ -63,45 +62,43 @@ class WorldState:
     def agents(self) -> tuple[AgentSpec, ...]:
         return self._now.agents
 
+    def revisions(self) -> dict[str, int]:
+        """Field name -> its revision now (a copy: keep it to ask :meth:`changed_since` later)."""
+        return dict(self._revisions)
+
+    def changed_since(self, seen: Mapping[str, int] | None) -> frozenset[str]:
+        """The fields whose revision moved since ``seen`` (from :meth:`revisions`; None: every field)."""
+        return frozenset(f for f, rev in self._revisions.items() if seen is None or seen[f] != rev)
+
     @property
     def revision(self) -> int:
         """Grows with every change."""
-        return self._revision
+        return sum(self._revisions.values())
 
     @property
     def layout_revision(self) -> int:
         """Grows when a door opens or closes or an object model changes (the maps change)."""
-        return self._layout_revision
+        return sum(self._revisions[f] for f in LAYOUT_FIELDS)
 
-    def write(self, *, sun_angle: float | None = None, lights: Mapping[str, bool] | None = None,
-              doors: Mapping[str, bool] | None = None, paint: Mapping[str, Mapping[str, str]] | None = None,
-              models: Mapping[str, int] | None = None, agents: Sequence[AgentSpec] | None = None) -> bool:
-        """Record the given items (for Appearance and, for ``agents``, the Simulation only); returns
-        whether anything changed. An item the world does not have is a KeyError (a caller's bug)."""
+    def write(self, **fields: Any) -> bool:
+        """Record the given fields of the model (for Appearance and, for ``agents``, the Simulation only);
+        a mapping is written over the current one (``paint={room: {surface: paint}}`` changes one
+        surface). Returns whether anything changed. An item the world does not have is a KeyError (a
+        caller's bug)."""
         now = self._now
-        _check_known(now.paint, paint or {})
-        new = replace(now, sun_angle=now.sun_angle if sun_angle is None else sun_angle,
-                      lights=_merged(now.lights, lights), doors=_merged(now.doors, doors),
-                      paint={room: _merged(surfaces, (paint or {}).get(room)) for room, surfaces in now.paint.items()},
-                      models=_merged(now.models, models), agents=now.agents if agents is None else tuple(agents))
-        if new == now:
-            return False
-        if new.doors != now.doors or new.models != now.models:
-            self._layout_revision += 1
+        new = now.changed(**{f: _merged(getattr(now, f), value) for f, value in fields.items()})
+        moved = [f for f in fields if getattr(new, f) != getattr(now, f)]
+        for f in moved:
+            self._revisions[f] += 1
         self._now = new
-        self._revision += 1
-        return True
+        return bool(moved)
 
 
-def _merged(items: Mapping[str, V], changes: Mapping[str, V] | None) -> Mapping[str, V]:
-    """``items`` with ``changes`` written over them."""
-    if not changes:
-        return items
-    _check_known(items, changes)
-    return {**items, **changes}
-
-
-def _check_known(items: Mapping, changes: Mapping) -> None:
-    for key in changes:
-        if key not in items:
+def _merged(now: Any, change: Any) -> Any:
+    """``change`` written over ``now``: item by item (and so on down) for mappings, whole otherwise."""
+    if not isinstance(change, Mapping):
+        return change
+    for key in change:
+        if key not in now:
             raise KeyError(f"unknown item {key!r}")
+    return {**now, **{key: _merged(now[key], value) for key, value in change.items()}}
