@@ -17,7 +17,7 @@ from dataclasses import replace
 import cv2
 import numpy as np
 import pytest
-from test_sensors import PROFILE, _box_house, _world
+from test_sensors import PROFILE, gl_box_world, restored_appearance
 
 from ravh_sim.sensors.camera import CameraOptions, SmartCamera
 from ravh_sim.world.appearance import Appearance
@@ -29,20 +29,8 @@ LOOK_DOWN = np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]])  # o
 CAMERA_HEIGHT = 2.7
 
 
-@pytest.fixture(scope="module")
-def world():
-    with _world(_box_house()) as w:
-        if w.renderer != "gl":
-            pytest.fail("the GL renderer must start on this machine (EGL + llvmpipe)")
-        yield w
-
-
-@pytest.fixture()
-def appearance(world):
-    app = Appearance(world)
-    before = world.state.settings()
-    yield app
-    app.apply(before)
+world = pytest.fixture(scope="module")(gl_box_world)
+appearance = pytest.fixture()(restored_appearance)
 
 
 def _camera_over(world: World) -> SmartCamera:
@@ -99,7 +87,7 @@ def _lamp_irradiance(world: World, light: str, x: float, y: float) -> float:
 
 def _lamp_alone(world, appearance, camera, light: str, x: float, y: float) -> tuple[TopDown, TopDown]:
     """Night, every light off but ``light``: frames with it on and off, looking down at (x, y)."""
-    appearance.set_sun("night")
+    appearance.set_knob("sun_angle", "night")
     appearance.set_lights("all", "off")
     off = TopDown(camera, x, y)
     appearance.set_light(light, True)
@@ -145,7 +133,7 @@ def test_floor_beside_furniture_is_darker_by_ambient_occlusion(world, appearance
     so without ambient occlusion the floor would be equally bright everywhere. It is beside the
     closet (front face at x = 8.3) that the floor darkens, and only there."""
     appearance.set_paint("B", "floor", GREY)
-    appearance.set_sun("day")
+    appearance.set_knob("sun_angle", "day")
     appearance.set_lights("all", "off")
     appearance.set_door("Door_0", False)
     view = TopDown(camera, 7.6, 2.6)
@@ -166,7 +154,7 @@ def test_auto_exposure_narrows_the_brightness_gap_a_fixed_exposure_keeps(world, 
     brightness: dict[str, list[float]] = {"fixed": [], "auto": []}
     try:
         for sun, lights in (("day", "off"), (170.0, "off"), ("night", "on")):
-            appearance.set_sun(sun)
+            appearance.set_knob("sun_angle", sun)
             appearance.set_lights("all", lights)
             for mode, camera in cameras.items():
                 grey = cv2.cvtColor(camera.capture(*pose).rgb, cv2.COLOR_RGB2GRAY)
@@ -200,7 +188,7 @@ def test_light_maps_follow_a_door_or_model_change(world, appearance, change, doo
     a World of its own, whose light maps were first drawn in the state before it."""
     appearance.set_paint("B", "floor", GREY)
     appearance.set_door("Door_0", door_open)
-    appearance.set_sun("night")
+    appearance.set_knob("sun_angle", "night")
     appearance.set_lights("all", "off")
     appearance.set_light(lit, True)
     with World(world.house, world.state.settings(), renderer=world.renderer) as changing:

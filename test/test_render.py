@@ -12,29 +12,17 @@ from dataclasses import replace
 import cv2
 import numpy as np
 import pytest
-from test_sensors import PROFILE, _box_house, _world
+from test_sensors import PROFILE, gl_box_world, restored_appearance
 
 from ravh_sim.render.materials import noise_volume
 from ravh_sim.sensors.camera import CameraOptions, SmartCamera
-from ravh_sim.world.appearance import Appearance, sun_light
+from ravh_sim.world.appearance import sun_light
 
 EXPOSURE = CameraOptions(manual_exposure=1.0)
 
 
-@pytest.fixture(scope="module")
-def world():
-    with _world(_box_house()) as w:
-        if w.renderer != "gl":
-            pytest.fail("the GL renderer must start on this machine (EGL + llvmpipe)")
-        yield w
-
-
-@pytest.fixture()
-def appearance(world):
-    app = Appearance(world)
-    before = world.state.settings()
-    yield app
-    app.apply(before)
+world = pytest.fixture(scope="module")(gl_box_world)
+appearance = pytest.fixture()(restored_appearance)
 
 
 def _camera(world, quality="realistic", options=EXPOSURE):

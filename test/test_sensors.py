@@ -115,13 +115,23 @@ def world(box_house):
         yield w
 
 
-@pytest.fixture()
-def appearance(world):
+def gl_box_world():
+    """The box house drawn by the GL renderer (tests of light need its shading, not the TinyRenderer's)."""
+    with _world(_box_house()) as w:
+        if w.renderer != "gl":
+            pytest.fail("the GL renderer must start on this machine (EGL + llvmpipe)")
+        yield w
+
+
+def restored_appearance(world):
     """Run-time appearance manager; restores the world's settings after each test."""
     app = Appearance(world)
-    before = resolve(load_settings(), world.house, 0)
+    before = world.state.settings()
     yield app
     app.apply(before)
+
+
+appearance = pytest.fixture()(restored_appearance)
 
 
 @pytest.fixture(scope="module")
