@@ -17,8 +17,8 @@ topics that have subscribers (no render, no JPEG for nobody); requested captures
 
 Camera frames are rendered and converted on one render thread (it owns the GL context, the cameras'
 renderers and every change to the world's appearance), so physics, /clock, odometry, /tf and scans
-keep their rates while a frame renders (in sim time: moderngl holds the GIL while it waits for llvmpipe,
-so on a CPU the loop pauses then and catches up after); a frame is stamped with the sim time of its pose.
+keep their rates while a frame renders (the renderer waits for llvmpipe with the GIL released); a frame
+is stamped with the sim time of its pose.
 ``frame_policy`` says what happens when a frame falls due while the last one still renders: ``drop``
 (default) skips it, keeping the real-time factor, as a real camera drops frames and as Nav2 and
 slam_toolbox expect of a clock that follows the wall clock (logged once); ``wait`` keeps every frame

@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from ravh_sim.render.backend import gl_context
+from ravh_sim.render.backend import gl_context, unlocked_gl
 from ravh_sim.render.geometry import ATTRIBUTES, VERTEX_FORMAT, SceneBuilder
 from ravh_sim.render.materials import NOISE_TEXELS, PATTERN, TEXELS, MaterialTable, noise_volume, srgb8_to_linear
 from ravh_sim.render.projection import look_at, orthographic, perspective, projection_from_K, view_matrix
@@ -173,6 +173,7 @@ class GLRenderer:
         if ctx is None:
             raise RuntimeError("no OpenGL context: use the tiny renderer")
         self.ctx, self.world = ctx, world
+        self.gl = unlocked_gl()
         self.width, self.height, self.near, self.far = width, height, near, far
         self.shadows = quality == "realistic"
         self.projection = projection_from_K(K, width, height, near, far)
@@ -626,6 +627,7 @@ class GLRenderer:
         _uniform(self.coverage_program, "u_instances").value = 0
         _uniform(self.coverage_program, "u_matrix").write(_mat(matrix))
         self.vaos["coverage"].render()
+        self.gl.finish()
         raw = np.frombuffer(self.coverage_raw.read(), np.float32).reshape(COVERAGE_TEXELS, COVERAGE_TEXELS)
         sigma = COVERAGE_BLUR_M * COVERAGE_TEXELS / span
         blurred = cv2.GaussianBlur(np.ascontiguousarray(raw), (0, 0), sigma)
@@ -688,14 +690,15 @@ class GLRenderer:
         ctx.depth_func = "<"
         _uniform(self.depth_program, "u_view_proj").write(_mat(view_proj))
         for first, count in self._runs.spans(visible):
-            self.vaos["depth"].render(first=first, vertices=count)
+            self.gl.draw(self.vaos["depth"], first, count)
         ctx.depth_func = "=="
         for k in self._patterns:
             for first, count in self._runs.spans(visible & (self._runs.pattern == k)):
-                self.vaos[f"scene{k}"].render(first=first, vertices=count)
+                self.gl.draw(self.vaos[f"scene{k}"], first, count)
         ctx.depth_func = "<="
         _uniform(self.sky_program, "u_inverse_view_proj").write(_mat(np.linalg.inv(view_proj)))
-        self.empty_vao.render(vertices=3)
+        self.gl.draw(self.empty_vao)
+
     def _exposure(self) -> float:
         """Auto-exposure as a camera's centre-weighted metering: the log luminance of the frame,
         the middle weighted CENTRE_WEIGHT times the edges, is brought part of the way to mid-grey
@@ -736,11 +739,13 @@ class GLRenderer:
         self.meter_fbo.use()
         _uniform(self.meter_program, "u_hdr").value = 0
         _uniform(self.meter_program, "u_block").value = METER_BLOCK
-        self.meter_vao.render(vertices=3)
+        self.gl.draw(self.meter_vao)
+        self.gl.finish()                     # waits for the frame without the GIL: read-backs then do not
         self.ldr_fbo.use()
         _uniform(self.tonemap_program, "u_hdr").value = 0
         _uniform(self.tonemap_program, "u_exposure").value = self._exposure() if exposure is None else exposure
-        self.tonemap_vao.render(vertices=3)
+        self.gl.draw(self.tonemap_vao)
+        self.gl.finish()
         h, w = self.height, self.width
         rgba = np.frombuffer(self.ldr_fbo.read(components=4), np.uint8).reshape(h, w, 4)[::-1]
         depth = np.frombuffer(self.depth.read(), np.float32).reshape(h, w)[::-1].copy()
