@@ -149,7 +149,7 @@ class SimNode(Node):
         self._last_warn = 0.0
         self._last_cmd: dict[str, float] = {}
         self._wall0, self._sim0 = time.monotonic(), rt.time
-        self._clock = Schedule.every(clock_rate, rt.world.physics_hz)
+        self._clock_due = Schedule.every(clock_rate, rt.world.physics_hz)
         self._clock_sent = -math.inf
         self._changes_in_batch = 0
         self._change_budget = WorkBudget(CHANGE_BURST_S, CHANGE_SHARE)
@@ -292,7 +292,7 @@ class SimNode(Node):
 
     def _publish_due(self) -> None:
         rt = self.runtime
-        if self._clock.due(rt.steps):
+        if self._clock_due.due(rt.steps):
             self._now()
         if rt.map_version != self._published_map:
             start = time.monotonic()
