@@ -135,6 +135,7 @@ class SimNode(Node):
             renderer=p["renderer"], rates=rates, footprint=p["footprint"] or None)
         self._frames: dict[str, Future] = {}          # agent -> its camera frame being rendered
         self._dropping = False
+        self._captures_rendering = 0
         rt = self.runtime
         self.get_logger().info(
             f"house {rt.house.number}: {len(rt.house.rooms)} rooms, {len(rt.house.objects)} objects, "
@@ -253,6 +254,8 @@ class SimNode(Node):
     def _tick(self) -> None:
         """Advance sim time towards wall time x RTF, publishing whatever falls due on the way."""
         rt = self.runtime
+        if self.rtf == 0 and self._captures_rendering:
+            return           # as fast as possible, yet not past a capture: readers would miss its parts
         last = rt.steps + self._max_steps
         if self.rtf > 0:
             last = min(last, rt.step_at(self._sim0 + self.rtf * (time.monotonic() - self._wall0)))
@@ -438,18 +441,24 @@ class SimNode(Node):
         not, then the event on ravh/capture (pose, room) so recorders can store it as one dataset
         sample. Everything is taken now (stamp, pose, the frame's number); the camera frame is rendered
         on the render thread, after the frames already queued, and the event waits for it, the tick
-        not: physics and /clock go on meanwhile."""
+        not: physics and /clock go on meanwhile. At real-time factor 0 (as fast as possible) the tick
+        does wait: there is no rate to keep, and a sim racing on would push the capture's readings out
+        of its readers' queues before they took them."""
         rt, stamp = self.runtime, self._now()
         event = rt.capture_event(agent)
         rendered = []
-        for port in SENSORS:
-            if port.name == CAMERA:
-                rendered.append(self.render_thread.submit(
-                    self._render_frame, agent, port, rt.frame_later(agent), stamp, port.topics))
-            else:
-                self._publish_sensor(agent, port, rt.read(agent, port.name), stamp, port.topics)
-        for frame in rendered:
-            await _awaitable(frame)
+        self._captures_rendering += 1
+        try:
+            for port in SENSORS:
+                if port.name == CAMERA:
+                    rendered.append(self.render_thread.submit(
+                        self._render_frame, agent, port, rt.frame_later(agent), stamp, port.topics))
+                else:
+                    self._publish_sensor(agent, port, rt.read(agent, port.name), stamp, port.topics)
+            for frame in rendered:
+                await _awaitable(frame)
+        finally:
+            self._captures_rendering -= 1
         self.agent_pubs[agent.name]["capture"].publish(String(data=event.to_json()))
         return event
 

@@ -180,6 +180,7 @@ class GLRenderer:
         self.materials = MaterialTable()
         self.builder = SceneBuilder(world, self.materials)
         header = _header()
+        self._uniforms: dict[tuple[str, tuple[int, ...]], list[moderngl.Uniform]] = {}     # see _set
         self.scene_programs = {k: ctx.program(vertex_shader=header + _source("scene.vert"),
                                               fragment_shader=_header(k) + _source("scene.frag"))
                                for k in range(len(PATTERN))}
@@ -250,6 +251,7 @@ class GLRenderer:
         self._lights_on: frozenset[str] | None = None
         self._shadowed: set[str] = set()                  # lights whose cube map is current
         self._light_row = {lt.id: row for row, lt in enumerate(world.house.lights)}
+        self._room_links = room_links(world.house)    # looked up once: hashing a House to find them is slow
         self._bounds = (np.zeros(3), np.ones(3))
         self._sun_matrix = np.eye(4)
         self._windows = self._window_lights()
@@ -455,13 +457,19 @@ class GLRenderer:
         self._lights = lights
 
     def _set(self, name: str, value, also: tuple = ()) -> None:
-        """Set a uniform on every scene program (and ``also``) that uses it; bytes are written raw."""
-        for program in (*self.scene_programs.values(), *also):
-            if name in program:
-                if isinstance(value, bytes):
-                    _uniform(program, name).write(value)
-                else:
-                    _uniform(program, name).value = value
+        """Set a uniform on every scene program (and ``also``) that uses it; bytes are written raw. Which
+        programs use it is looked up once: ``name in program`` walks all of a program's members, and a
+        frame sets a few dozen uniforms on each of the programs."""
+        key = (name, tuple(id(program) for program in also))
+        uniforms = self._uniforms.get(key)
+        if uniforms is None:
+            uniforms = self._uniforms[key] = [_uniform(program, name) for program in
+                                              (*self.scene_programs.values(), *also) if name in program]
+        for uniform in uniforms:
+            if isinstance(value, bytes):
+                uniform.write(value)
+            else:
+                uniform.value = value
 
     def _set_frame_lights(self, position: np.ndarray) -> None:
         """The lamps that can light this view: switched-on lights reaching the camera's room or a
@@ -515,7 +523,7 @@ class GLRenderer:
         rooms = {room}
         if self.shadows:
             doors = self.world.state.doors
-            for link in room_links(self.world.house):
+            for link in self._room_links:
                 if room in link.rooms and (link.door is None or doors.get(link.door, True)):
                     rooms.update(link.rooms)
         return rooms
