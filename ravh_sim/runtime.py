@@ -3,7 +3,8 @@
 :class:`SimRuntime` is what the sim node wraps: it builds the World from a house and settings, keeps
 the Simulation (physics + agents), each agent's sensors (one per port of
 :data:`~ravh_sim.sensors.suite.SENSORS`), the Navigation Manager and the ground truth, and says which
-sensors are due at the current sim time (rates from each agent's robot profile). Everything here is plain
+sensors are due at the current physics step (rates from each agent's robot profile, as whole steps:
+:class:`Schedule`). Everything here is plain
 Python, so the whole data path (house file -> World -> sensors) is tested without a ROS graph, and the
 node only converts and publishes.
 """
@@ -11,7 +12,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
@@ -47,6 +49,34 @@ ABSURD_LINEAR = 10.0      # m/s
 ABSURD_ANGULAR = 20.0     # rad/s
 ODOM = "odom"             # the rate key of odometry, the true pose and /tf (a sensor's key is its port's name)
 PORTS = {port.name: port for port in SENSORS}
+STAMP_RESOLUTION = 1e-9   # s: a ROS stamp's resolution (a stamp within it of a physics step is that step)
+RATE_DENOMINATOR = 10**6  # rates are read as the fractions they were written as (7.3 Hz = 73/10 Hz)
+
+
+@dataclass
+class Schedule:
+    """When the readings of one rate fall due, in whole physics steps (as gym-pybullet-drones schedules
+    control, so sim time = step x dt and nothing drifts or needs a float tolerance): reading j at the
+    first step at or after j / rate seconds, step ceil(j x physics Hz / rate), exactly in fractions
+    (30 Hz at 240 Hz physics: every 8 steps; 100 Hz: steps 0, 3, 5, 8, 10, ...). Asked after each
+    step; a reading due at a step not asked about is taken at the next one, and none is made up."""
+    steps_per_reading: Fraction | None     # None: never (rate 0)
+    next_reading: int = 0
+
+    @staticmethod
+    def every(rate: float, physics_hz: float) -> Schedule:
+        if rate <= 0:
+            return Schedule(None)
+        return Schedule(Fraction(physics_hz).limit_denominator(RATE_DENOMINATOR)
+                        / Fraction(rate).limit_denominator(RATE_DENOMINATOR))
+
+    def due(self, step: int) -> bool:
+        """True (and the reading taken) when a reading is due at physics step ``step``."""
+        per = self.steps_per_reading
+        if per is None or step < math.ceil(self.next_reading * per):
+            return False
+        self.next_reading = math.floor(step / per) + 1       # the first reading due after this step
+        return True
 
 
 @dataclass
@@ -56,8 +86,8 @@ class Agent:
     profile: RobotProfile
     sensors: dict[str, Any]          # port name -> the sensor (a SmartCamera, a Laser, ...)
     rates: dict[str, float]          # Hz of sim time by rate key (ODOM and each port's name); 0 = never
+    schedules: dict[str, Schedule]   # when each rate key's readings fall due
     first: bool                      # the first agent uses the plain topic names
-    next_due: dict[str, float] = field(default_factory=dict)
 
 
 class SimRuntime:
@@ -87,8 +117,10 @@ class SimRuntime:
             profile = load_profile(spec.profile)
             sensors = {port.name: port.build(self.world, profile.spec(port), spec.name) for port in SENSORS}
             own = {ODOM: profile.odom_rate, **{port.name: port.rate(profile.spec(port)) for port in SENSORS}}
-            self.agents.append(Agent(spec.name, self.sim.robot(spec.name), profile, sensors,
-                                     {**own, **(rates or {})}, i == 0))
+            agent_rates = {**own, **(rates or {})}
+            schedules = {key: Schedule.every(rate, self.world.physics_hz) for key, rate in agent_rates.items()}
+            self.agents.append(Agent(spec.name, self.sim.robot(spec.name), profile, sensors, agent_rates,
+                                     schedules, i == 0))
         self.navigation = Navigation(self.house, self.world.state, self.agents[0].profile
                                      if self.agents else load_profile(names.DEFAULT_PROFILE))
         self.ground_truth = GroundTruth(self.house, self.world.state)
@@ -103,22 +135,22 @@ class SimRuntime:
     def time(self) -> float:
         return self.sim.time
 
+    @property
+    def steps(self) -> int:
+        """Physics steps since the start (sim time = steps x dt)."""
+        return self.sim.steps
+
+    def step_at(self, t: float) -> int:
+        """The first physics step at or after sim time ``t`` seconds (a stamp: to its resolution)."""
+        return math.ceil((t - STAMP_RESOLUTION) * self.world.physics_hz)
+
     def step(self, n: int = 1) -> None:
         self.sim.step(n)
 
     def due(self, agent: Agent, what: str) -> bool:
-        """True (and schedules the next one) when ``what`` (a rate key: ODOM or a port's name) is due
-        for ``agent``."""
-        rate = agent.rates[what]
-        if rate <= 0:
-            return False
-        t = self.time
-        nxt = agent.next_due.get(what, 0.0)
-        if t + 1e-9 < nxt:
-            return False
-        period = 1.0 / rate
-        agent.next_due[what] = max(nxt + period, t + period * 0.5)
-        return True
+        """True (and the reading taken) when ``what`` (a rate key: ODOM or a port's name) is due for
+        ``agent`` at the current step."""
+        return agent.schedules[what].due(self.steps)
 
     # ------------------------------------------------------------------ sensing
     def read(self, agent: Agent, port: str) -> Any:

@@ -11,7 +11,7 @@ import pytest
 from ravh_msgs_py import appearance
 from ravh_msgs_py.query import QueryError
 from ravh_sim.errors import UserError
-from ravh_sim.runtime import SimRuntime
+from ravh_sim.runtime import Schedule, SimRuntime
 from ravh_sim.sensors.camera import OPTICAL_ROTATION
 
 
@@ -32,6 +32,36 @@ def test_sensors_fall_due_at_their_rates(runtime):
             counts[what] += runtime.due(agent, what)
     assert counts == {"camera": pytest.approx(20, abs=1), "scan": pytest.approx(20, abs=1),
                       "odom": pytest.approx(100, abs=1)}
+
+
+def _float_schedule(rate: float, physics_hz: float, steps: int) -> list[int]:
+    """The steps readings fell due at before step counters: float sim time with a tolerance, asked
+    after each step as the sim node does (the reference the schedule must keep)."""
+    period, next_due, due = 1.0 / rate, 0.0, []
+    for step in range(1, steps + 1):
+        t = step * (1.0 / physics_hz)
+        if t + 1e-9 >= next_due:
+            due.append(step)
+            next_due = max(next_due + period, t + period * 0.5)
+    return due
+
+
+@pytest.mark.parametrize("rate", [30.0, 10.0, 50.0, 100.0, 120.0, 7.0, 7.3, 29.97, 3.0, 0.7])
+def test_step_schedules_keep_the_float_schedule(rate):
+    """Rates that divide the physics rate and rates that do not (100 Hz: 2.4 steps; 7.3 Hz, 29.97 Hz)
+    fall due at the steps they did when sim time was a float, over ten simulated minutes."""
+    physics_hz, steps = 240.0, 240 * 600
+    schedule = Schedule.every(rate, physics_hz)
+    assert [step for step in range(1, steps + 1) if schedule.due(step)] == _float_schedule(rate, physics_hz, steps)
+
+
+def test_a_step_schedule_counts_whole_steps():
+    camera, clock, never = (Schedule.every(rate, 240.0) for rate in (30.0, 100.0, 0.0))
+    assert [step for step in range(1, 50) if camera.due(step)] == [1, 8, 16, 24, 32, 40, 48]
+    assert [step for step in range(1, 20) if clock.due(step)] == [1, 3, 5, 8, 10, 12, 15, 17]
+    assert not any(never.due(step) for step in range(1000))
+    late = Schedule.every(30.0, 240.0)
+    assert [step for step in (1, 20, 23, 24, 30, 32) if late.due(step)] == [1, 20, 24, 32]   # none made up
 
 
 def test_a_frame_not_taken_still_uses_up_its_number(runtime):

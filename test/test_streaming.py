@@ -19,6 +19,7 @@ from sensor_msgs.msg import Image, LaserScan
 from std_srvs.srv import Trigger
 
 from ravh_msgs_py import names as n
+from ravh_msgs_py.capture import CaptureEvent
 from ravh_sim.nodes import convert
 from ravh_sim.render.views import RenderedViews
 from ravh_sim.sensors import imaging
@@ -29,11 +30,12 @@ PERIOD = 0.1                       # the camera's and the laser's period (giraff
 
 
 class StandInRenderer:
-    """Flat views after ``slow()`` says the render may end; records the sim time each render began."""
+    """Flat views after ``slow()`` says the render may end; records the sim time each render began and ended."""
 
     def __init__(self, node, width: int, height: int) -> None:
         self.node, self.shape = node, (height, width)
         self.began: list[float] = []
+        self.ended: list[float] = []
         self.slow: Callable[[float], bool] = lambda began: True
 
     def render(self, position, rotation, exposure=None, radiance=False) -> RenderedViews:
@@ -42,6 +44,7 @@ class StandInRenderer:
         give_up = time.monotonic() + 60.0
         while not self.slow(began) and time.monotonic() < give_up:
             time.sleep(0.002)
+        self.ended.append(self.node.runtime.time)
         h, w = self.shape
         return RenderedViews(np.full((h, w, 3), 128, np.uint8), np.full((h, w), 2.0, np.float32),
                              np.ones((h, w), np.uint16), np.zeros((h, w), bool))
@@ -149,6 +152,24 @@ class TestDroppingFrames:
         assert len(scan_t) >= (window[1] - window[0]) / PERIOD - 1
         assert np.allclose(np.diff(scan_t), PERIOD, atol=1e-3)          # every scan, none late
         assert np.diff(clock_t).max() < 2 * session.sim.clock_period       # on physics steps: no gap
+
+    def test_a_capture_waits_for_its_frame_while_the_clock_goes_on(self, session):
+        # the renderer ends a frame only once the sim has run a second past its start: a capture
+        # rendered on the control loop's tick would stall the clock and never end
+        session.renderer.slow = lambda began: session.sim.runtime.time >= began + 1.0
+        clock, images = session.listen(Clock, n.CLOCK), session.listen(Image, n.COLOR_IMAGE)
+        rendered = len(session.renderer.ended)
+        reply = session.capture()
+        assert reply.success, reply.message
+        event = CaptureEvent.from_json(reply.message)
+        # its frame, stamped at its instant (to the nanosecond of a header stamp)
+        session.spin_until(lambda: np.isclose(stamps(images), event.stamp, rtol=0, atol=1e-9).any())
+        ended = np.array(session.renderer.ended[rendered:])
+        began = np.array(session.renderer.began[rendered:rendered + len(ended)])
+        assert len(ended) and np.all(ended >= began + 1.0)    # every render, the capture's too, saw the sim run on
+        clock_t = stamps(clock)
+        clock_t = clock_t[clock_t >= event.stamp]
+        assert np.diff(clock_t).max() < 2 * session.sim.clock_period   # on physics steps: no gap
 
 
 class TestWaitingForFrames:

@@ -17,8 +17,8 @@ topics that have subscribers (no render, no JPEG for nobody); requested captures
 
 Camera frames are rendered and converted on one render thread (it owns the GL context, the cameras'
 renderers and every change to the world's appearance), so physics, /clock, odometry, /tf and scans
-keep their rates while a frame renders (in sim time: moderngl holds the GIL while it waits for llvmpipe,
-so on a CPU the loop pauses then and catches up after); a frame is stamped with the sim time of its pose.
+keep their rates while a frame renders (the renderer waits for llvmpipe with the GIL released); a frame
+is stamped with the sim time of its pose.
 ``frame_policy`` says what happens when a frame falls due while the last one still renders: ``drop``
 (default) skips it, keeping the real-time factor, as a real camera drops frames and as Nav2 and
 slam_toolbox expect of a clock that follows the wall clock (logged once); ``wait`` keeps every frame
@@ -36,6 +36,7 @@ import time
 from collections import deque
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
+from functools import partial
 from typing import Any
 
 from diagnostic_msgs.srv import AddDiagnostics
@@ -43,9 +44,11 @@ from geometry_msgs.msg import PoseStamped, TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import OccupancyGrid, Odometry
 from nav_msgs.srv import GetMap, GetPlan
 from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.task import Future as RosFuture
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import String
 from std_srvs.srv import Trigger
@@ -69,7 +72,7 @@ from ravh_sim.nodes.common import (
     run_node,
 )
 from ravh_sim.render.backend import BACKENDS
-from ravh_sim.runtime import ODOM, Agent, SimRuntime
+from ravh_sim.runtime import ODOM, Agent, Schedule, SimRuntime
 from ravh_sim.sensors.ports import SensorPort, Topic
 from ravh_sim.sensors.suite import SENSORS
 
@@ -122,7 +125,8 @@ class SimNode(Node):
         self.frame_policy = str(p["frame_policy"])
         if self.frame_policy not in FRAME_POLICIES:
             raise UserError(f"frame_policy must be one of {', '.join(FRAME_POLICIES)}, got {self.frame_policy!r}")
-        self.clock_period = 1.0 / max(float(p["clock_rate"]), 1e-3)
+        clock_rate = max(float(p["clock_rate"]), 1e-3)
+        self.clock_period = 1.0 / clock_rate
         # The one thread that touches the renderers: the process's GL context is made, and stays current,
         # on the thread that builds the runtime (ravh_sim.render.backend), so the runtime is built there.
         self.render_thread = ThreadPoolExecutor(max_workers=1, thread_name_prefix="ravh_render")
@@ -131,12 +135,14 @@ class SimNode(Node):
             renderer=p["renderer"], rates=rates, footprint=p["footprint"] or None)
         self._frames: dict[str, Future] = {}          # agent -> its camera frame being rendered
         self._dropping = False
+        self._captures_rendering = 0
         rt = self.runtime
         self.get_logger().info(
             f"house {rt.house.number}: {len(rt.house.rooms)} rooms, {len(rt.house.objects)} objects, "
             f"renderer {rt.world.renderer}, seed {rt.world.state.seed}, real-time factor {self.rtf:g}")
         self.lockstep = bool(p["lockstep"])
-        self._allowed, self._heartbeat = rt.time, 0.0     # lockstep: sim time granted; last wall beat
+        self._allowed, self._heartbeat = rt.steps, 0.0    # lockstep: the step granted; last wall beat
+        self._max_steps = round(MAX_STEP_S * rt.world.physics_hz)
         self._make_publishers()
         self._make_subscriptions(bool(p["cmd_vel_stamped"]))
         self._make_services()
@@ -144,7 +150,7 @@ class SimNode(Node):
         self._last_warn = 0.0
         self._last_cmd: dict[str, float] = {}
         self._wall0, self._sim0 = time.monotonic(), rt.time
-        self._next_clock = 0.0
+        self._clock_due = Schedule.every(clock_rate, rt.world.physics_hz)
         self._clock_sent = -math.inf
         self._changes_in_batch = 0
         self._change_budget = WorkBudget(CHANGE_BURST_S, CHANGE_SHARE)
@@ -209,9 +215,11 @@ class SimNode(Node):
         srv(GetMap, n.GET_FREE_SPACE_SERVICE, lambda req, res: self._on_get_map(res, self.runtime.navigation.map))
         srv(GetPlan, n.GET_PLAN_SERVICE, self._on_get_plan)
         srv(Trigger, n.RESET_SERVICE, self._on_reset)
+        # Captures in a group of their own: the executor runs the tick while a capture waits for its frame.
+        captures = MutuallyExclusiveCallbackGroup()
         for agent in self.runtime.agents:
             srv(Trigger, n.agent_name(n.CAPTURE_SERVICE, agent.name, agent.first),
-                lambda req, res, a=agent: self._on_capture(a, res))
+                partial(self._on_capture, agent), callback_group=captures)
 
     def _json_service(self, name: str, handler: Callable) -> None:
         """A JSON service that answers every request waiting for it: the executor takes one request
@@ -246,19 +254,19 @@ class SimNode(Node):
     def _tick(self) -> None:
         """Advance sim time towards wall time x RTF, publishing whatever falls due on the way."""
         rt = self.runtime
+        if self.rtf == 0 and self._captures_rendering:
+            return           # as fast as possible, yet not past a capture: readers would miss its parts
+        last = rt.steps + self._max_steps
         if self.rtf > 0:
-            target = self._sim0 + self.rtf * (time.monotonic() - self._wall0)
-            target = min(target, rt.time + MAX_STEP_S)
-        else:
-            target = rt.time + MAX_STEP_S
+            last = min(last, rt.step_at(self._sim0 + self.rtf * (time.monotonic() - self._wall0)))
         if self.lockstep:
-            target = min(target, self._allowed)
+            last = min(last, self._allowed)
         deadline = time.monotonic() + MAX_STEP_S
-        while rt.time + 1e-9 < target and time.monotonic() < deadline:
+        while rt.steps < last and time.monotonic() < deadline:
             self._watchdog()
             rt.step()
             self._publish_due()
-        if self.lockstep and rt.time + 1e-9 >= self._allowed and time.monotonic() - self._heartbeat > HEARTBEAT_S:
+        if self.lockstep and rt.steps >= self._allowed and time.monotonic() - self._heartbeat > HEARTBEAT_S:
             self._arrived()
         if self.rtf > 0 and rt.time + MAX_STEP_S < self._sim0 + self.rtf * (time.monotonic() - self._wall0):
             self._wall0, self._sim0 = time.monotonic(), rt.time       # fell behind: do not try to catch up
@@ -266,7 +274,7 @@ class SimNode(Node):
     def _on_step(self, agent: Agent, msg: TwistStamped) -> None:
         """Lockstep: the behaviour's command for the next step and the sim time it may run to."""
         self._on_cmd(agent, msg.twist)
-        self._allowed = max(self._allowed, convert.seconds(msg.header.stamp))
+        self._allowed = max(self._allowed, self.runtime.step_at(convert.seconds(msg.header.stamp)))
         self._heartbeat = 0.0
 
     def _arrived(self) -> None:
@@ -287,9 +295,8 @@ class SimNode(Node):
 
     def _publish_due(self) -> None:
         rt = self.runtime
-        if rt.time + 1e-9 >= self._next_clock:
+        if self._clock_due.due(rt.steps):
             self._now()
-            self._next_clock += self.clock_period
         if rt.map_version != self._published_map:
             start = time.monotonic()
             self._publish_map()                  # a door or a model changed: the change's cost
@@ -429,17 +436,29 @@ class SimNode(Node):
             self._charged.discard(key)
             self._change_budget.spend(seconds)
 
-    def _publish_capture(self, agent: Agent) -> CaptureEvent:
+    async def _publish_capture(self, agent: Agent) -> CaptureEvent:
         """A requested capture: every sensor of the agent at one stamp on every topic, subscribed or
-        not (rendered on the render thread, after the frames already queued), then the event on
-        ravh/capture (pose, room) so recorders can store it as one dataset sample."""
+        not, then the event on ravh/capture (pose, room) so recorders can store it as one dataset
+        sample. Everything is taken now (stamp, pose, the frame's number); the camera frame is rendered
+        on the render thread, after the frames already queued, and the event waits for it, the tick
+        not: physics and /clock go on meanwhile. At real-time factor 0 (as fast as possible) the tick
+        does wait: there is no rate to keep, and a sim racing on would push the capture's readings out
+        of its readers' queues before they took them."""
         rt, stamp = self.runtime, self._now()
-        for port in SENSORS:
-            if port.name == CAMERA:
-                self._on_render_thread(self._render_frame, agent, port, rt.frame_later(agent), stamp, port.topics)
-            else:
-                self._publish_sensor(agent, port, rt.read(agent, port.name), stamp, port.topics)
-        event = self.runtime.capture_event(agent)
+        event = rt.capture_event(agent)
+        rendered = []
+        self._captures_rendering += 1
+        try:
+            for port in SENSORS:
+                if port.name == CAMERA:
+                    rendered.append(self.render_thread.submit(
+                        self._render_frame, agent, port, rt.frame_later(agent), stamp, port.topics))
+                else:
+                    self._publish_sensor(agent, port, rt.read(agent, port.name), stamp, port.topics)
+            for frame in rendered:
+                await _awaitable(frame)
+        finally:
+            self._captures_rendering -= 1
         self.agent_pubs[agent.name]["capture"].publish(String(data=event.to_json()))
         return event
 
@@ -537,9 +556,9 @@ class SimNode(Node):
             response.success, response.message = False, f"{type(e).__name__}: {e}"
         return response
 
-    def _on_capture(self, agent: Agent, response: Trigger.Response):
+    async def _on_capture(self, agent: Agent, request: Trigger.Request, response: Trigger.Response):
         try:
-            event = self._publish_capture(agent)
+            event = await self._publish_capture(agent)
             response.success, response.message = True, event.to_json()
         except Exception as e:  # never die from a request
             response.success, response.message = False, f"{type(e).__name__}: {e}"
@@ -573,6 +592,21 @@ class WorkBudget:
         with self._lock:
             self._refill()
             return 0.0 if self.level > 0 else -self.level / self.share
+
+
+def _awaitable(future: Future) -> RosFuture:
+    """A future of another thread as one an rclpy coroutine callback can await (the executor resumes
+    the callback on its turns until the future is done); its result or exception."""
+    awaited = RosFuture()
+
+    def hand_over(done: Future) -> None:
+        error = done.exception()
+        if error is None:
+            awaited.set_result(done.result())
+        else:
+            awaited.set_exception(error)
+    future.add_done_callback(hand_over)
+    return awaited
 
 
 def _forget_if_oversized(request: AddDiagnostics.Request) -> None:

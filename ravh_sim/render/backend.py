@@ -8,9 +8,13 @@ beside it, has crashed Mesa here).
 """
 from __future__ import annotations
 
+import ctypes
 import sys
+from collections.abc import Callable
+from ctypes.util import find_library
+from dataclasses import dataclass
 from functools import lru_cache
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     import moderngl
@@ -43,3 +47,43 @@ def gl_context() -> moderngl.Context | None:
     except Exception:                      # no libEGL, no driver, GL too old: all mean "no GL"
         return None
     return ctx
+
+
+
+GL_TRIANGLES = 0x0004
+
+
+@dataclass(frozen=True)
+class UnlockedGL:
+    """The GL calls of a frame that wait for llvmpipe, made through ctypes, which lets go of the GIL
+    during a foreign call (moderngl holds it): the sim's other threads run while a frame is drawn. A
+    draw waits when llvmpipe's queue of binned scenes is full (a frame's later passes wait there for
+    its earlier ones to be rasterised), a read-back when the frame is not finished (``finish`` first)."""
+    finish: Callable[[], None]
+    use_program: Callable[[int], None]
+    bind_vertex_array: Callable[[int], None]
+    draw_arrays: Callable[[int, int, int], None]
+
+    def draw(self, vao: moderngl.VertexArray, first: int = 0, vertices: int = 3) -> None:
+        """What ``vao.render(first=first, vertices=vertices)`` does for triangles, without the GIL."""
+        self.use_program(vao.program.glo)
+        self.bind_vertex_array(vao.glo)
+        self.draw_arrays(GL_TRIANGLES, first, vertices)
+
+
+@lru_cache(maxsize=1)
+def unlocked_gl() -> UnlockedGL:
+    """The GL calls of the process's context (current on the calling thread) that release the GIL."""
+    egl = ctypes.CDLL(find_library("EGL") or "libEGL.so.1")     # the library moderngl's context is on
+    egl.eglGetProcAddress.restype = ctypes.c_void_p
+    egl.eglGetProcAddress.argtypes = [ctypes.c_char_p]
+
+    def function(name: str, *arguments: type) -> Any:
+        address = egl.eglGetProcAddress(name.encode())
+        if not address:
+            raise RuntimeError(f"EGL has no {name}")
+        return ctypes.CFUNCTYPE(None, *arguments)(address)
+
+    return UnlockedGL(function("glFinish"), function("glUseProgram", ctypes.c_uint),
+                      function("glBindVertexArray", ctypes.c_uint),
+                      function("glDrawArrays", ctypes.c_uint, ctypes.c_int, ctypes.c_int))

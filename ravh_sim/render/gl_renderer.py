@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from ravh_sim.render.backend import gl_context
+from ravh_sim.render.backend import gl_context, unlocked_gl
 from ravh_sim.render.geometry import ATTRIBUTES, VERTEX_FORMAT, SceneBuilder
 from ravh_sim.render.materials import NOISE_TEXELS, PATTERN, TEXELS, MaterialTable, noise_volume, srgb8_to_linear
 from ravh_sim.render.projection import look_at, orthographic, perspective, projection_from_K, view_matrix
@@ -177,12 +177,14 @@ class GLRenderer:
         if ctx is None:
             raise RuntimeError("no OpenGL context: use the tiny renderer")
         self.ctx, self.world = ctx, world
+        self.gl = unlocked_gl()
         self.width, self.height, self.near, self.far = width, height, near, far
         self.shadows = quality == "realistic"
         self.projection = projection_from_K(K, width, height, near, far)
         self.materials = MaterialTable()
         self.builder = SceneBuilder(world, self.materials)
         header = _header()
+        self._uniforms: dict[tuple[str, tuple[int, ...]], list[moderngl.Uniform]] = {}     # see _set
         self.scene_programs = {k: ctx.program(vertex_shader=header + _source("scene.vert"),
                                               fragment_shader=_header(k) + _source("scene.frag"))
                                for k in range(len(PATTERN))}
@@ -252,6 +254,7 @@ class GLRenderer:
         self._lights_on: frozenset[str] | None = None
         self._shadowed: set[str] = set()                  # lights whose cube map is current
         self._light_row = {lt.id: row for row, lt in enumerate(world.house.lights)}
+        self._room_links = room_links(world.house)    # looked up once: hashing a House to find them is slow
         self._bounds = (np.zeros(3), np.ones(3))
         self._sun_matrix = np.eye(4)
         self._windows = self._window_lights()
@@ -461,13 +464,19 @@ class GLRenderer:
         self._lights = lights
 
     def _set(self, name: str, value, also: tuple = ()) -> None:
-        """Set a uniform on every scene program (and ``also``) that uses it; bytes are written raw."""
-        for program in (*self.scene_programs.values(), *also):
-            if name in program:
-                if isinstance(value, bytes):
-                    _uniform(program, name).write(value)
-                else:
-                    _uniform(program, name).value = value
+        """Set a uniform on every scene program (and ``also``) that uses it; bytes are written raw. Which
+        programs use it is looked up once: ``name in program`` walks all of a program's members, and a
+        frame sets a few dozen uniforms on each of the programs."""
+        key = (name, tuple(id(program) for program in also))
+        uniforms = self._uniforms.get(key)
+        if uniforms is None:
+            uniforms = self._uniforms[key] = [_uniform(program, name) for program in
+                                              (*self.scene_programs.values(), *also) if name in program]
+        for uniform in uniforms:
+            if isinstance(value, bytes):
+                uniform.write(value)
+            else:
+                uniform.value = value
 
     def _set_frame_lights(self, position: np.ndarray) -> None:
         """The lamps that can light this view: switched-on lights reaching the camera's room or a
@@ -521,7 +530,7 @@ class GLRenderer:
         rooms = {room}
         if self.shadows:
             doors = self.world.state.doors
-            for link in room_links(self.world.house):
+            for link in self._room_links:
                 if room in link.rooms and (link.door is None or doors.get(link.door, True)):
                     rooms.update(link.rooms)
         return rooms
@@ -633,6 +642,7 @@ class GLRenderer:
         _uniform(self.coverage_program, "u_instances").value = 0
         _uniform(self.coverage_program, "u_matrix").write(_mat(matrix))
         self.vaos["coverage"].render()
+        self.gl.finish()
         raw = np.frombuffer(self.coverage_raw.read(), np.float32).reshape(COVERAGE_TEXELS, COVERAGE_TEXELS)
         sigma = COVERAGE_BLUR_M * COVERAGE_TEXELS / span
         blurred = cv2.GaussianBlur(np.ascontiguousarray(raw), (0, 0), sigma)
@@ -695,14 +705,15 @@ class GLRenderer:
         ctx.depth_func = "<"
         _uniform(self.depth_program, "u_view_proj").write(_mat(view_proj))
         for first, count in self._runs.spans(visible):
-            self.vaos["depth"].render(first=first, vertices=count)
+            self.gl.draw(self.vaos["depth"], first, count)
         ctx.depth_func = "=="
         for k in self._patterns:
             for first, count in self._runs.spans(visible & (self._runs.pattern == k)):
-                self.vaos[f"scene{k}"].render(first=first, vertices=count)
+                self.gl.draw(self.vaos[f"scene{k}"], first, count)
         ctx.depth_func = "<="
         _uniform(self.sky_program, "u_inverse_view_proj").write(_mat(np.linalg.inv(view_proj)))
-        self.empty_vao.render(vertices=3)
+        self.gl.draw(self.empty_vao)
+
     def _exposure(self) -> float:
         """Auto-exposure as a camera's centre-weighted metering: the log luminance of the frame,
         the middle weighted CENTRE_WEIGHT times the edges, is brought part of the way to mid-grey
@@ -743,11 +754,13 @@ class GLRenderer:
         self.meter_fbo.use()
         _uniform(self.meter_program, "u_hdr").value = 0
         _uniform(self.meter_program, "u_block").value = METER_BLOCK
-        self.meter_vao.render(vertices=3)
+        self.gl.draw(self.meter_vao)
+        self.gl.finish()                     # waits for the frame without the GIL: read-backs then do not
         self.ldr_fbo.use()
         _uniform(self.tonemap_program, "u_hdr").value = 0
         _uniform(self.tonemap_program, "u_exposure").value = self._exposure() if exposure is None else exposure
-        self.tonemap_vao.render(vertices=3)
+        self.gl.draw(self.tonemap_vao)
+        self.gl.finish()
         h, w = self.height, self.width
         rgba = np.frombuffer(self.ldr_fbo.read(components=4), np.uint8).reshape(h, w, 4)[::-1]
         depth = np.frombuffer(self.depth.read(), np.float32).reshape(h, w)[::-1].copy()

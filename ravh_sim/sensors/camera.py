@@ -273,14 +273,15 @@ class SmartCamera:
         frame = self.render(x, y, yaw, floor_z)
         rgb, depth, instance = frame.rgb, frame.depth, frame.instance
         rng = noise_rng(self.world.state.seed, NOISE_STREAM, self.agent, index)
-        distance = float(np.nanmedian(depth)) if np.isfinite(depth).any() else self.spec.far
+        blur = velocity if opts.motion_blur else (0.0, 0.0)
+        # how far the scene is sets how much a motion blurs it (a median over the frame: only for a blur)
+        distance = float(np.nanmedian(depth)) if any(blur) and np.isfinite(depth).any() else self.spec.far
         if self.sensor is not None:          # exposure, blur over it, noise, white balance, clipping
-            blur = velocity if opts.motion_blur else (0.0, 0.0)
             if frame.radiance is not None:
                 rgb, _ = self.sensor.expose(frame.radiance, rng, self.K, blur, distance)
             else:
                 rgb, _ = self.sensor.from_rendered(rgb, rng, self.K, blur, distance)
-        elif opts.motion_blur and any(velocity):
+        elif any(blur):
             rgb = imaging.motion_blur(rgb, self.K, velocity[0], velocity[1], opts.exposure, distance)
         if self._lens is not None:
             rgb = self._lens.apply(rgb)
