@@ -21,6 +21,7 @@ from ravh_sim.paths import FASTDDS_PROFILE
 
 SIM_LOST_S = 8.0        # wall seconds without /clock after which a sim counts as gone
 STOP_LATENCY_S = 0.1    # longest a spinning node takes to notice SIGINT/SIGTERM
+DRAIN_S = 10.0          # longest a stopping node spends finishing the requests it took
 
 SENSOR_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=5, reliability=ReliabilityPolicy.RELIABLE,
                         durability=DurabilityPolicy.VOLATILE)
@@ -146,6 +147,12 @@ def spin_until_stopped(node, stop: StopSignals) -> None:
     finished = getattr(node, "finished", None)
     stop.interrupting = False
     while not stop.requested and not (finished is not None and finished.done()):
+        executor.spin_once(timeout_sec=STOP_LATENCY_S)
+    # Requests the node took before the stop are answered, not dropped (a capture whose frame is still
+    # rendering is published and replied to), within a bound.
+    in_flight = getattr(node, "in_flight", None)
+    deadline = time.monotonic() + DRAIN_S
+    while in_flight is not None and in_flight() and time.monotonic() < deadline:
         executor.spin_once(timeout_sec=STOP_LATENCY_S)
 
 

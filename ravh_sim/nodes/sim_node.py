@@ -564,6 +564,10 @@ class SimNode(Node):
             response.success, response.message = False, f"{type(e).__name__}: {e}"
         return response
 
+    def in_flight(self) -> bool:
+        """Whether a requested capture is still waiting for its frame (spin_until_stopped finishes it)."""
+        return self._captures_rendering > 0
+
     def close(self) -> None:
         self._on_render_thread(self.runtime.close)
         self.render_thread.shutdown()
