@@ -119,3 +119,27 @@ def test_spinning_until_a_behaviour_ends_keeps_nothing_per_callback():
         rclpy.get_global_executor().remove_node(node)
         node.destroy_node()
     assert sizes[1] - sizes[0] < 50_000, sizes          # with rclpy.spin_until_future_complete: +80 KB
+
+
+def test_a_stopped_node_first_finishes_the_requests_it_took():
+    """After a stop signal the node is still spun while its ``in_flight()`` says a request it took is
+    unfinished (the sim's capture waiting for its frame), and no longer than that."""
+    import rclpy
+    from rosgraph import start_rclpy
+
+    from ravh_sim.nodes.common import StopSignals, spin_until_stopped
+
+    start_rclpy()
+    node = rclpy.create_node("drain")
+    ticks = [0]
+    node.create_timer(0.001, lambda: ticks.__setitem__(0, ticks[0] + 1))
+    node.in_flight = lambda: ticks[0] < 20          # the request ends on the 20th turn
+    stop = StopSignals()
+    stop.requested = True                           # the stop came before the first spin
+    try:
+        spin_until_stopped(node, stop)
+    finally:
+        stop.restore()
+        rclpy.get_global_executor().remove_node(node)
+        node.destroy_node()
+    assert ticks[0] == 20
