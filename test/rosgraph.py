@@ -96,26 +96,34 @@ def start_rclpy() -> None:
 
 
 def remove_orphan_shm(since: float) -> int:
-    """Delete Fast DDS shared-memory files made after ``since`` (epoch s) that no process holds any more:
-    what a SIGKILLed participant leaves behind. A segment is held where a process maps it; its lock
-    (``_el``, held open, never mapped) and its mutex (``sem.*_mutex``) go with it. Returns how many
-    were removed."""
+    """Delete Fast DDS shared-memory files made after ``since`` (epoch s) whose owner is gone: what a
+    SIGKILLed participant leaves behind. A participant holds its segment's lock (``_el``) open for its
+    whole life, while its peers (this test process among them) map the segment to write into it; so a
+    segment with a lock is owned while some process holds the lock open, whoever maps it. A file without a
+    lock is held where a process maps or opens it; a mutex (``sem.*_mutex``) goes with its segment.
+    Returns how many were removed."""
     import glob
-    held: set[str] = set()
+    mapped: set[str] = set()
+    opened: set[str] = set()
     for pid in glob.glob("/proc/[0-9]*"):
         try:
             with open(f"{pid}/maps") as f:
-                held.update(line.split()[-1] for line in f if "/dev/shm/" in line)
+                mapped.update(line.split()[-1] for line in f if "/dev/shm/" in line)
             for fd in os.scandir(f"{pid}/fd"):
-                held.add(os.readlink(fd.path))
+                opened.add(os.readlink(fd.path))
         except OSError:
             continue
+
+    def owned(segment: str) -> bool:
+        lock = segment + "_el"
+        return lock in opened if os.path.exists(lock) else segment in mapped or segment in opened
+
     removed = 0
     for path in glob.glob("/dev/shm/*fastrtps_*"):
         name = os.path.basename(path)
         segment = "/dev/shm/" + name.removeprefix("sem.").removesuffix("_mutex").removesuffix("_el")
         try:
-            if os.path.getmtime(path) >= since and path not in held and segment not in held:
+            if os.path.getmtime(path) >= since and not owned(segment):
                 os.remove(path)
                 removed += 1
         except OSError:
