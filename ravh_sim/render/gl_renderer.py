@@ -43,7 +43,9 @@ if TYPE_CHECKING:
 
 KINDS = {"floor": 0, "ceiling": 1, "walls": 2, "object": 3, "door": 4, "window": 5}
 MAX_LIGHTS = 32                       # switched-on lights with a shadow map
-FRAME_LIGHTS = 4                      # lights shading one frame (the nearest)
+FRAME_LIGHTS = 4                      # lights shading one frame (the nearest; at most 8: u_room_lights)
+assert FRAME_LIGHTS <= 8, "u_room_lights packs light indices in 3 bits"
+MAX_ROOMS = 32                        # rooms of a house (the 30 houses have at most 14)
 MAX_WINDOWS = 32                      # windows of a house (the 30 houses have at most 14)
 WINDOW_SPAN = 64                      # a room's windows: first + WINDOW_SPAN * count (scene.frag)
 FRAME_LIGHT_REACH = 9.0               # m: lights farther from the camera are left out of a frame
@@ -100,6 +102,7 @@ def _header(pattern: int = -1) -> str:
     defines.append(f"#define PATTERN_ID {pattern}")
     defines += [f"#define KIND_{name.upper()} {i}" for name, i in KINDS.items()]
     defines.append(f"#define MAX_LIGHTS {MAX_LIGHTS}")
+    defines.append(f"#define MAX_ROOMS {MAX_ROOMS}")
     defines.append(f"#define MAX_WINDOWS {MAX_WINDOWS}")
     defines.append(f"#define WINDOW_SPAN {WINDOW_SPAN}")
     return "#version 430\n" + "\n".join(defines) + "\n" + _source("common.glsl") + "\n"
@@ -483,7 +486,7 @@ class GLRenderer:
         room open to it, the nearest FRAME_LIGHTS of them within FRAME_LIGHT_REACH (a CPU
         rasteriser pays for every light on every pixel)."""
         index = {room.id: i for i, room in enumerate(self.world.house.rooms)}
-        assert len(index) <= 32, "a light's room mask holds 32 rooms"
+        assert len(index) <= MAX_ROOMS, f"the renderer takes {MAX_ROOMS} rooms"
         camera_room = self.world.house.room_at(float(position[0]), float(position[1]))
         around = self._lit_rooms(camera_room.id) if camera_room is not None else set(index)
         near = sorted((float(np.linalg.norm(np.asarray(lt.position) - position)), self._light_row[lt.id], lt)
@@ -491,15 +494,18 @@ class GLRenderer:
         chosen = [(row, lt) for d, row, lt in near if d < FRAME_LIGHT_REACH][:FRAME_LIGHTS]
         positions = np.zeros((MAX_LIGHTS, 4), np.float32)
         powers = np.zeros((MAX_LIGHTS, 4), np.float32)
-        reach = np.zeros(MAX_LIGHTS, np.int32)
+        reaching: dict[int, list[int]] = {}          # room index -> the chosen lights reaching it
         for i, (row, lt) in enumerate(chosen):
             positions[i] = (*lt.position, lt.range)
             powers[i] = (*(np.asarray(lt.color) * lt.intensity * LAMP_POWER), row if self.shadows else -1)
-            reach[i] = sum(1 << index[room] for room in self._lit_rooms(lt.room))
-        self._set("u_light_count", len(chosen))
+            for room in self._lit_rooms(lt.room):
+                reaching.setdefault(index[room], []).append(i)
+        room_lights = np.zeros(MAX_ROOMS, np.int32)   # scene.frag: count in bits 0-3, then 3 bits per light
+        for room_index, lights in reaching.items():
+            room_lights[room_index] = len(lights) + sum(i << (4 + 3 * k) for k, i in enumerate(lights))
         self._set("u_light_position", positions.tobytes())
         self._set("u_light_power", powers.tobytes())
-        self._set("u_light_rooms", reach.tobytes())
+        self._set("u_room_lights", room_lights.tobytes())
 
     def _window_lights(self) -> tuple[np.ndarray, np.ndarray, dict[str, tuple[int, int]]]:
         """Every window as an area light, grouped by room: (centre, 0), (normal into its room, area)

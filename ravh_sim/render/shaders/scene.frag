@@ -28,10 +28,10 @@ uniform mat4 u_sun_matrix;
 uniform vec3 u_sun_irradiance;
 uniform vec4 u_coverage_box;          // x0, y0, 1/width, 1/height in metres
 uniform vec3 u_eye;
-uniform int u_light_count;
 uniform vec4 u_light_position[MAX_LIGHTS];   // xyz, range
 uniform vec4 u_light_power[MAX_LIGHTS];      // rgb, shadow row (-1: none; then confined to its room)
-uniform int u_light_rooms[MAX_LIGHTS];       // bit r: the light reaches room r (its own, open doors)
+uniform int u_room_lights[MAX_ROOMS];        // the frame's lights reaching each room (its own, open doors):
+                                             // bits 0-3 their count, then 3 bits per light index
 uniform vec2 u_atlas_texels;                 // atlas size in texels
 uniform float u_tile;                        // texels per cube face
 uniform int u_shadows;                       // realistic quality: shadows on
@@ -342,12 +342,15 @@ void main() {
             float lit = u_shadows == 1 ? sun_shadow(v_world, geometric) : 1.0;
             colour += brdf(n, v, u_sun_dir, s.albedo, s.roughness, s.metalness) * u_sun_irradiance * n_l * lit;
         }
-        // Lamps and ceiling lights, branch-free (a CPU rasteriser pays for divergent branches):
+        // Lamps and ceiling lights reaching this room, branch-free inside (a CPU rasteriser pays for
+        // divergent branches, but a loop ends once no pixel of a block has lights left):
         // Lambert plus a normalised Blinn-Phong lobe matched to the roughness.
         float shininess = 2.0 / max(s.roughness * s.roughness * s.roughness * s.roughness, 1e-3);
         float lobe = (shininess + 8.0) / (8.0 * PI);
         vec3 lamp_diffuse = diffuse_albedo / PI;
-        for (int i = 0; i < u_light_count; ++i) {
+        int lights = u_room_lights[room];
+        for (int k = 0; k < (lights & 15); ++k) {
+            int i = (lights >> (4 + 3 * k)) & 7;
             vec3 d = v_world - u_light_position[i].xyz;
             float dist2 = dot(d, d);
             float range2 = u_light_position[i].w * u_light_position[i].w;
@@ -355,10 +358,9 @@ void main() {
             float n_l_lamp = max(dot(n, l), 0.0);
             float window = clamp(1.0 - dist2 * dist2 / (range2 * range2), 0.0, 1.0);
             float row = u_light_power[i].w;
-            float here = float((u_light_rooms[i] >> room) & 1);
-            float lit = (row >= 0.0 && here > 0.0 && n_l_lamp > 0.0) ? lamp_shadow(row, d + geometric * 0.02) : 1.0;
+            float lit = (row >= 0.0 && n_l_lamp > 0.0) ? lamp_shadow(row, d + geometric * 0.02) : 1.0;
             float n_h = max(dot(n, normalize(v + l)), 0.0);
-            vec3 irradiance = u_light_power[i].rgb * (window * window * here * lit * n_l_lamp / (dist2 + 0.04));
+            vec3 irradiance = u_light_power[i].rgb * (window * window * lit * n_l_lamp / (dist2 + 0.04));
             colour += irradiance * (lamp_diffuse + f0 * lobe * pow(n_h, shininess));
         }
 #if PATTERN_ID == PATTERN_EMISSIVE
