@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import signal
 import sys
 from collections import Counter
 from collections.abc import Callable
@@ -218,6 +219,7 @@ def cmd_raid(args: argparse.Namespace) -> int:
     houses = available_houses() if args.all else [args.house]
     if not args.all:
         load_house(args.house)                        # unknown house: the usual clear error
+    signal.signal(signal.SIGINT, _interrupt_once)
     results = []
     for house in houses:
         out = args.out / f"house{house:02d}_raid{args.raid}" if args.all else args.out
@@ -227,6 +229,14 @@ def cmd_raid(args: argparse.Namespace) -> int:
             break
     print(json.dumps(results if args.all else results[0], indent=1))
     return 0 if all(Outcome.of(r["status"]).complete for r in results) else 1
+
+
+def _interrupt_once(signum: int, frame: Any) -> None:
+    """The first Ctrl-C interrupts the raid; later presses are ignored until the process exits. Python
+    resets its own handler to the default at exit, so a second press landing while the interpreter shuts
+    down would otherwise kill the raid by the signal after its summary, and change its exit status."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    raise KeyboardInterrupt
 
 
 def cmd_bench(args: argparse.Namespace) -> int:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from rosgraph import NodeProcess, ros_env
+from rosgraph import NodeProcess, remove_orphan_shm, ros_env
 
 from ravh_sim.dataset.api import Dataset
 from ravh_sim.errors import UserError
@@ -189,8 +189,9 @@ def _group_alive(pgid: int) -> bool:
 
 
 def test_ctrl_c_ends_a_raid_with_its_summary(tmp_path):
-    """Ctrl-C in a terminal reaches the raid and its processes (one process group), pressed twice here:
-    the raid still stops every process, prints its summary, writes raid.json and leaves a readable dataset."""
+    """Ctrl-C in a terminal reaches the raid and its processes (one process group), pressed again and again
+    here until the raid exits: the raid still stops every process, prints its summary, writes raid.json, exits
+    with its own status (not killed by a press landing while Python shuts down) and leaves a readable dataset."""
     out = tmp_path / "raid"
     raid = subprocess.Popen([sys.executable, "-m", "ravh_sim.cli", "raid", "--house", "20", "--raid", "1", "--fast",
                              "--out", str(out)], env=ros_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
@@ -200,11 +201,11 @@ def test_ctrl_c_ends_a_raid_with_its_summary(tmp_path):
         while len(_rows(out / "captures.jsonl")) < 3 and raid.poll() is None and time.monotonic() < end:
             time.sleep(0.5)
         assert len(_rows(out / "captures.jsonl")) >= 3 and raid.poll() is None, _log_tails(out)
-        os.killpg(raid.pid, signal.SIGINT)
-        time.sleep(0.3)                                   # the second press lands while the raid winds down
-        if raid.poll() is None:
-            os.killpg(raid.pid, signal.SIGINT)
-        stdout, stderr = raid.communicate(timeout=120)
+        end = time.monotonic() + 120
+        while raid.poll() is None and time.monotonic() < end:   # later presses land while the raid winds
+            os.killpg(raid.pid, signal.SIGINT)                  # down, writes its summary and exits
+            time.sleep(0.05)
+        stdout, stderr = raid.communicate(timeout=10)
     finally:
         if _group_alive(raid.pid):
             os.killpg(raid.pid, signal.SIGKILL)
@@ -228,9 +229,15 @@ def test_a_full_disk_ends_a_raid_with_one_line_and_its_summary(tmp_path):
     """Images and the bag do not fit (200 kB per file), small files do: the recorder ends with one line,
     the raid says which process stopped, and nothing half-written or temporary is left in the dataset."""
     out = tmp_path / "raid"
-    raid = subprocess.run([sys.executable, "-c", FILE_SIZE_LIMITED, "200000", "-m", "ravh_sim.cli", "raid",
-                           "--house", "20", "--raid", "1", "--fast", "--out", str(out)],
-                          env=ros_env(), capture_output=True, text=True, timeout=300)
+    started = time.time()
+    try:
+        raid = subprocess.run([sys.executable, "-c", FILE_SIZE_LIMITED, "200000", "-m", "ravh_sim.cli", "raid",
+                               "--house", "20", "--raid", "1", "--fast", "--out", str(out)],
+                              env=ros_env(), capture_output=True, text=True, timeout=300)
+    finally:
+        # The limit holds for /dev/shm too: each process's Fast DDS segment stops at 1 byte and stays there
+        # (Fast DDS falls back to UDP).
+        remove_orphan_shm(started)
     assert raid.returncode == 1, raid.stderr[-3000:] + _log_tails(out)
     saved = json.loads((out / "raid.json").read_text())
     assert json.loads(raid.stdout) == saved
