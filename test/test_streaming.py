@@ -96,7 +96,8 @@ class Session:
         return future.result()
 
     def close(self) -> None:
-        self.executor.shutdown()
+        self.renderer.slow = lambda began: True     # a frame still rendering would wait for sim time that
+        self.executor.shutdown()                    # no longer passes once the executor stops (60 s)
         self.sim.close()
         self.sim.destroy_node()
         self.node.destroy_node()
