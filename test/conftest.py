@@ -42,6 +42,23 @@ def resolved(house, settings=None, seed=0):
     return resolve(settings or load_settings(), house, seed)
 
 
+@pytest.fixture(scope="module")
+def world(houses):
+    """House 15 built with the TinyRenderer, shared by a module's tests (a module may define its own)."""
+    from ravh_sim.world.scene import World
+    with World(houses[15], resolved(houses[15]), renderer="tiny") as w:
+        yield w
+
+
+@pytest.fixture()
+def appearance(world):
+    """The appearance manager of the shared world, put back to its initial settings after each test."""
+    from ravh_sim.world.appearance import Appearance
+    app = Appearance(world)
+    yield app
+    app.apply(resolved(world.house))
+
+
 def pytest_sessionfinish(session, exitstatus) -> None:
     """Remove the node logs this run wrote (rosgraph.NodeProcess): a failing test has already quoted them."""
     import glob

@@ -28,19 +28,6 @@ RANDOMISE = {"lights": {"sun_angle": "random", "ceiling": "random", "lamps": "ra
              "models": {"all": "random"}}
 
 
-@pytest.fixture(scope="module")
-def world(houses):
-    with World(houses[15], resolved(houses[15]), renderer="tiny") as w:
-        yield w
-
-
-@pytest.fixture()
-def appearance(world):
-    app = Appearance(world)
-    yield app
-    app.apply(resolved(world.house))
-
-
 def full_state(world: World) -> dict:
     """Everything a change could touch: the state and its revisions, the footprint, and per instance
     its pybullet pose, collision and visual shapes, what the renderer draws (mesh, paint)."""

@@ -16,7 +16,7 @@ from conftest import ROOT, resolved, subprocess_env
 
 from ravh_msgs_py.appearance import parse
 from ravh_sim.world.appearance import Appearance
-from ravh_sim.world.scene import OPEN_DOOR_DROP, World
+from ravh_sim.world.scene import OPEN_DOOR_DROP
 from ravh_sim.world.solids import model_count
 
 MB = 2**20
@@ -105,12 +105,6 @@ def test_model_swaps_rendered_by_the_gl_renderer_grow_nothing():
 
 
 # ------------------------------------------------------------------ what the World keeps
-
-@pytest.fixture(scope="module")
-def world(houses):
-    with World(houses[15], resolved(houses[15]), renderer="tiny") as w:
-        yield w
-
 
 def test_a_swapped_out_model_is_parked_out_of_the_house_and_comes_back(world):
     appearance = Appearance(world)

@@ -9,26 +9,11 @@ import pytest
 from conftest import ROOT, resolved
 from pydantic import ValidationError
 
-from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.ground_truth import GroundTruth
 from ravh_sim.world.scene import World
 from ravh_sim.world.settings import Resolved
 from ravh_sim.world.state import WorldState
-
-
-@pytest.fixture(scope="module")
-def world(houses):
-    with World(houses[15], resolved(houses[15]), renderer="tiny") as w:
-        yield w
-
-
-@pytest.fixture()
-def appearance(world):
-    """The appearance manager of the shared world, put back to its initial settings after each test."""
-    app = Appearance(world)
-    yield app
-    app.apply(resolved(world.house))
 
 
 def _revisions(world: World) -> tuple[int, int]:
