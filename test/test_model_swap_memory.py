@@ -12,10 +12,9 @@ import subprocess
 import sys
 
 import pytest
-from conftest import ROOT, resolved, subprocess_env
+from conftest import ROOT, subprocess_env
 
 from ravh_msgs_py.appearance import parse
-from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.scene import OPEN_DOOR_DROP
 from ravh_sim.world.solids import model_count
 
@@ -106,8 +105,7 @@ def test_model_swaps_rendered_by_the_gl_renderer_grow_nothing():
 
 # ------------------------------------------------------------------ what the World keeps
 
-def test_a_swapped_out_model_is_parked_out_of_the_house_and_comes_back(world):
-    appearance = Appearance(world)
+def test_a_swapped_out_model_is_parked_out_of_the_house_and_comes_back(world, appearance):
     body, pose = world.instance("Bed_0").body, world.object_pose("Bed_0")
     start = world.state.models["Bed_0"]
     other = (start + 1) % 2
@@ -127,16 +125,14 @@ def test_a_swapped_out_model_is_parked_out_of_the_house_and_comes_back(world):
     appearance.set_object_model("Bed_0", other)
     assert world.body_to_instance_lut().size == count
     assert world.object_pose("Bed_0")[0][2] > world.floor_z - 1.0 > pose[0][2] - OPEN_DOOR_DROP
-    appearance.set_object_model("Bed_0", start)
 
 
-def test_the_gl_scene_builder_keeps_only_models_the_world_shows(world):
+def test_the_gl_scene_builder_keeps_only_models_the_world_shows(world, appearance):
     from ravh_sim.render.geometry import SceneBuilder
     from ravh_sim.render.materials import MaterialTable
-    appearance, builder = Appearance(world), SceneBuilder(world, MaterialTable())
+    builder = SceneBuilder(world, MaterialTable())
     for seed in range(6):
         appearance.change(parse({"models": {"all": "random"}, "seed": seed}))
         builder.build()
         shown = {id(v.model if v.model is not None else v.mesh) for v in world.visuals.values()} - {id(None)}
         assert set(builder._arrays) <= shown                     # swapped-out (parked) models: forgotten
-    appearance.apply(resolved(world.house))
