@@ -230,20 +230,24 @@ def route_poses(world: Any, profile: Any, step: float = ROUTE_STEP_M) -> list[tu
 
 
 def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
-    """Sensor speed: one camera capture (RGB + depth + instance, 640x480) with the realistic GL
-    renderer, the fast GL renderer and pybullet's TinyRenderer (the baseline), on the same poses in
-    the same run, and their ratios; realistic at night with every light on (its worst case); one
-    360-ray laser scan.
+    """Sensor speed: one camera capture (RGB + depth + instance, 640x480) as the sim publishes it with
+    each camera profile: realistic (the giraff profile: the realistic GL renderer and its sensor
+    model), fast (giraff_fast: fast GL, no sensor) and pybullet's TinyRenderer (the baseline, its
+    frames developed through the same sensor in numpy), on the same poses in the same run, and their
+    ratios; realistic at night with every light on (its worst case); the realistic ideal camera
+    (giraff_ideal: no sensor model); one 360-ray laser scan.
 
     Poses: the station and every room centre that lies inside its room, headings turning by 90
-    degrees, default settings (day, ceiling lights on); and, as ``route_*``, frames every metre along
-    the route ``ravh bench node`` drives. Medians over all poses and repeats.
+    degrees, default settings (day, ceiling lights on), the robot still; and, as ``route_*``, frames
+    every metre along the route ``ravh bench node`` drives, the robot moving at its cruise speed (its
+    sensor blurs them). Medians over all poses and repeats.
     """
     from dataclasses import replace
 
+    from ravh_msgs_py import names
     from ravh_sim.render.backend import resolve_backend
     from ravh_sim.robot.profile import load_profile
-    from ravh_sim.sensors.camera import SmartCamera
+    from ravh_sim.sensors.camera import PORT
     from ravh_sim.sensors.laser import Laser
     from ravh_sim.world.appearance import Appearance
     from ravh_sim.world.geometry import polygon_centroid
@@ -254,8 +258,10 @@ def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
     settings = load_settings()
     profile = load_profile()
     detail: dict[str, Any] = {}
-    configs = {"realistic": ("gl", "realistic"), "fast": ("gl", "fast"), "tiny": ("tiny", "fast"),
-               "realistic_night_all_lights": ("gl", "realistic")}
+    sensor = profile.camera.sensor           # the giraff profile's; giraff_fast and giraff_ideal have none
+    configs = {"realistic": ("gl", "realistic", sensor), "fast": ("gl", "fast", None),
+               "tiny": ("tiny", "fast", sensor), "realistic_night_all_lights": ("gl", "realistic", sensor),
+               "realistic_ideal": ("gl", "realistic", None)}
     camera_ms: dict[str, list[float]] = {name: [] for name in configs}
     route_ms: dict[str, list[float]] = {name: [] for name in configs}
     scan_ms: list[float] = []
@@ -266,7 +272,7 @@ def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
             cx, cy = polygon_centroid(room.floor)
             if room.contains(cx, cy):
                 poses.append((cx, cy, i * math.pi / 2))
-        for name, (backend, quality) in configs.items():
+        for name, (backend, quality, with_sensor) in configs.items():
             world = World(house, resolve(settings, house), renderer=resolve_backend(backend))
             if world.renderer != backend:
                 world.close()
@@ -275,14 +281,15 @@ def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
                 appearance = Appearance(world)
                 appearance.set_knob("sun_angle", "night")
                 appearance.set_lights("all", "on")
-            camera = SmartCamera(world, replace(profile.camera, quality=quality))
+            spec = replace(profile.camera, quality=quality, sensor=with_sensor)
+            camera = PORT.build(world, spec, names.DEFAULT_AGENT)
             camera.capture(*poses[0])                         # shadow maps and buffers are made once
             times = [_timed(camera.capture, *pose)[0] * 1000
                      for _ in range(SENSOR_REPEATS) for pose in poses]
             camera_ms[name] += times
             detail[f"house{n}_camera_ms_{name}"] = round(statistics.median(times), 2)
-            route = route_poses(world, profile)
-            route_ms[name] += [_timed(camera.capture, *pose)[0] * 1000 for pose in route]
+            route, cruise = route_poses(world, profile), (profile.max_linear_speed, 0.0)
+            route_ms[name] += [_timed(camera.capture, *pose, None, cruise)[0] * 1000 for pose in route]
             detail[f"house{n}_route_frames"] = len(route)
             if name == "tiny":
                 laser = Laser(world, profile.laser)

@@ -38,7 +38,7 @@ class StandInRenderer:
         self.ended: list[float] = []
         self.slow: Callable[[float], bool] = lambda began: True
 
-    def render(self, position, rotation, exposure=None, radiance=False) -> RenderedViews:
+    def render(self, position, rotation, exposure=None, radiance=False, development=None) -> RenderedViews:
         began = self.node.runtime.time
         self.began.append(began)
         give_up = time.monotonic() + 60.0

@@ -7,10 +7,13 @@ expensive light transport is computed when the scene changes, not per frame: the
 (orthographic over the house; the ceiling and walls shadow the rooms, so sunlight enters only
 through the window openings), one cube shadow map per switched-on lamp (walls confine its light;
 open doors let it through) and a top-down coverage map that gives floors their ambient occlusion.
-Per frame: the pass, the procedural sky behind the windows, block metering for auto-exposure and a
-tone map (ACES, sRGB) that refuses non-finite radiance (RenderError) instead of returning a black
-frame. ``fast`` quality draws every surface with the plain material in one pass, skips shadow
-look-ups and reflections, and confines lamps to their room instead.
+Per frame: the pass, the procedural sky behind the windows, block metering for auto-exposure (it
+also counts pixels of non-finite radiance: such a frame is refused with RenderError instead of
+returned black), then either a tone map (ACES, sRGB) at the renderer's own exposure or a camera
+sensor's development (shaders/sensor_*.frag: exposure, motion sweep, shot and read noise, ADC, white
+balance, the same curve), so only finished 8-bit images leave the device. ``fast`` quality draws
+every surface with the plain material in one pass, skips shadow look-ups and reflections, and
+confines lamps to their room instead.
 
 Light units are arbitrary but consistent (exposure adapts): the sun gives SUN_IRRADIANCE on a
 surface facing it at noon, a lamp of intensity 1 gives LAMP_POWER / d^2, a window is an area light
@@ -31,7 +34,7 @@ from ravh_sim.render.backend import gl_context, unlocked_gl
 from ravh_sim.render.geometry import ATTRIBUTES, VERTEX_FORMAT, SceneBuilder
 from ravh_sim.render.materials import NOISE_TEXELS, PATTERN, TEXELS, MaterialTable, noise_volume, srgb8_to_linear
 from ravh_sim.render.projection import look_at, orthographic, perspective, projection_from_K, view_matrix
-from ravh_sim.render.views import RenderedViews
+from ravh_sim.render.views import Development, Exposure, RenderedViews, typical_depth
 from ravh_sim.world.appearance import SunLight, lamps_at, sun_light
 from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import Light
@@ -51,6 +54,7 @@ WINDOW_SPAN = 64                      # a room's windows: first + WINDOW_SPAN * 
 FRAME_LIGHT_REACH = 9.0               # m: lights farther from the camera are left out of a frame
 SUN_SHADOW_TEXELS = 2048
 LAMP_TILE = 192                       # texels per cube face of a lamp's shadow map
+LAMP_SHADOW_RANGE = 64.0              # m: a lamp's shadow map stores distance / this as its depth
 PROBE_TILE = 64                       # texels per cube face of a room's reflection probe
 PROBE_HEIGHT = 1.3                    # m above the floor where a room's probe sits
 PROBE_FAR = 30.0
@@ -105,6 +109,7 @@ def _header(pattern: int = -1) -> str:
     defines.append(f"#define MAX_ROOMS {MAX_ROOMS}")
     defines.append(f"#define MAX_WINDOWS {MAX_WINDOWS}")
     defines.append(f"#define WINDOW_SPAN {WINDOW_SPAN}")
+    defines.append(f"#define LAMP_SHADOW_RANGE {LAMP_SHADOW_RANGE:.1f}")
     return "#version 430\n" + "\n".join(defines) + "\n" + _source("common.glsl") + "\n"
 
 
@@ -182,6 +187,7 @@ class GLRenderer:
         self.ctx, self.world = ctx, world
         self.gl = unlocked_gl()
         self.width, self.height, self.near, self.far = width, height, near, far
+        self.K = np.asarray(K, np.float64)
         self.shadows = quality == "realistic"
         self.projection = projection_from_K(K, width, height, near, far)
         self.materials = MaterialTable()
@@ -205,11 +211,16 @@ class GLRenderer:
                                           fragment_shader=header + _source("shadow.frag"))
         self.coverage_program = ctx.program(vertex_shader=header + _source("coverage.vert"),
                                             fragment_shader=header + _source("coverage.frag"))
+        self.sensor_programs = {name: ctx.program(vertex_shader=header + _source("fullscreen.vert"),
+                                                  fragment_shader=header + _source(f"sensor_{name}.frag"))
+                                for name in ("expose", "balance", "develop")}
         self.empty_vao = ctx.vertex_array(self.sky_program, [])
         self.tonemap_vao = ctx.vertex_array(self.tonemap_program, [])
         self.meter_vao = ctx.vertex_array(self.meter_program, [])
+        self.sensor_vaos = {name: ctx.vertex_array(program, []) for name, program in self.sensor_programs.items()}
         size = (width, height)
         self.hdr = ctx.texture(size, 4, dtype="f2")
+        self.hdr.repeat_x = self.hdr.repeat_y = False      # a motion sweep repeats the edge pixels
         self.depth = ctx.texture(size, 1, dtype="f4")
         self.instance = ctx.texture(size, 1, dtype="i4")
         for texture in (self.depth, self.instance):
@@ -218,8 +229,12 @@ class GLRenderer:
         self.ldr = ctx.texture(size, 4)
         self.ldr_fbo = ctx.framebuffer([self.ldr])
         meter_size = (-(-width // METER_BLOCK), -(-height // METER_BLOCK))
-        self.meter = ctx.texture(meter_size, 2, dtype="f4")
+        self.meter = ctx.texture(meter_size, 4, dtype="f4")
         self.meter_fbo = ctx.framebuffer([self.meter])
+        self.signal = ctx.texture(size, 4, dtype="f4")         # a sensor's signal, full-scale units
+        self.signal_fbo = ctx.framebuffer([self.signal])
+        self.balance = ctx.texture(meter_size, 4, dtype="f4")   # its block means, for white balance
+        self.balance_fbo = ctx.framebuffer([self.balance])
         rows, cols = np.meshgrid((np.arange(meter_size[1]) + 0.5) / meter_size[1] - 0.5,
                                  (np.arange(meter_size[0]) + 0.5) / meter_size[0] - 0.5, indexing="ij")
         self._meter_weights = 1.0 + (CENTRE_WEIGHT - 1.0) * np.exp(-(rows ** 2 + cols ** 2) / (2 * CENTRE_SPREAD ** 2))
@@ -266,6 +281,8 @@ class GLRenderer:
         """Free the GPU objects (the context stays: it belongs to the process)."""
         for obj in (*self.scene_programs.values(), self.depth_program, self.sky_program, self.tonemap_program,
                     self.shadow_program, self.coverage_program, self.meter_program, self.meter, self.meter_fbo,
+                    *self.sensor_programs.values(), *self.sensor_vaos.values(), self.signal, self.signal_fbo,
+                    self.balance, self.balance_fbo,
                     self.hdr, self.depth, self.instance, self.main_fbo, self.ldr,
                     self.ldr_fbo, self.sun_depth, self.sun_fbo, self.coverage_raw, self.coverage_fbo,
                     self.coverage, self.noise, self.room_map, self.room_light, self.instance_texture,
@@ -569,6 +586,7 @@ class GLRenderer:
         _uniform(self.shadow_program, "u_materials").value = 0
         _uniform(self.shadow_program, "u_matrix").write(_mat(matrix))
         _uniform(self.shadow_program, "u_origin").value = tuple(float(v) for v in origin)
+        _uniform(self.shadow_program, "u_radial").value = int(room is not None)
         (self.vaos["shadow"] if room is None else self._room_vaos[room][0]).render()
 
     def _render_lamp_shadows(self, lights: list[Light]) -> None:
@@ -576,16 +594,16 @@ class GLRenderer:
         of the house, so switching one light redraws only its row)."""
         if self.atlas_fbo is None:
             size = (6 * LAMP_TILE, max(len(self.world.house.lights), 1) * LAMP_TILE)
-            self.atlas = self.ctx.texture(size, 1, dtype="f4")
-            self.atlas.filter = (self.ctx.NEAREST, self.ctx.NEAREST)
-            self.atlas_fbo = self.ctx.framebuffer([self.atlas], self.ctx.depth_renderbuffer(size))
+            self.atlas = self.ctx.depth_texture(size)
+            self.atlas.compare_func = "<="                # a look-up is the share of 2 x 2 texels lit
+            self.atlas.filter = (self.ctx.LINEAR, self.ctx.LINEAR)
+            self.atlas_fbo = self.ctx.framebuffer(depth_attachment=self.atlas)
             self._set("u_atlas_texels", (float(size[0]), float(size[1])))
             self._set("u_tile", float(LAMP_TILE))
         self.atlas_fbo.use()
         for lt in lights:
             row = self._light_row[lt.id]
-            self.atlas_fbo.clear(1e4, 1e4, 1e4, 1e4, depth=1.0,
-                                 viewport=(0, row * LAMP_TILE, 6 * LAMP_TILE, LAMP_TILE))
+            self.atlas_fbo.clear(depth=1.0, viewport=(0, row * LAMP_TILE, 6 * LAMP_TILE, LAMP_TILE))
             for face, matrix in enumerate(self._face_matrices(lt.range)):
                 self.atlas_fbo.viewport = (face * LAMP_TILE, row * LAMP_TILE, LAMP_TILE, LAMP_TILE)
                 self._draw_casters(matrix, np.asarray(lt.position), lt.room)
@@ -662,7 +680,7 @@ class GLRenderer:
         units: tuple[tuple[str, moderngl.Texture | moderngl.Texture3D | moderngl.TextureArray], ...] = (
             ("u_materials", self.material_texture), ("u_library", self.library_textures),
             ("u_instances", self.instance_texture),
-            ("u_sun_shadow", self.sun_depth), ("u_point_shadow", _either(self.atlas, self.depth)),
+            ("u_sun_shadow", self.sun_depth), ("u_point_shadow", _either(self.atlas, self.sun_depth)),
             ("u_coverage", self.coverage), ("u_noise", self.noise), ("u_room_map", self.room_map),
             ("u_room_light", self.room_light), ("u_probes", _either(self.probes, self.hdr)),
             ("u_probe_boxes", _either(self.probe_boxes, self.room_light)))
@@ -726,7 +744,7 @@ class GLRenderer:
         (a camera keeps a dusk room dimmer than a noon one), within the camera's range (so a dark
         room stays dark instead of turning grey). Highlights count at most METER_HIGHLIGHT above
         the median, so a bright window clips to white while the room is exposed for, as in a photo."""
-        blocks = np.frombuffer(self.meter.read(), np.float32).reshape(self._meter_weights.shape + (2,))
+        blocks = self._meter_blocks()
         weights = blocks[..., 1] * self._meter_weights + 1e-9
         log_luminance = np.minimum(blocks[..., 0], np.median(blocks[..., 0]) + METER_HIGHLIGHT)
         average = math.exp(float(np.average(log_luminance, weights=weights)))
@@ -734,11 +752,18 @@ class GLRenderer:
         adapted = EXPOSURE_REFERENCE * (average / EXPOSURE_REFERENCE) ** adaptation
         return float(np.clip(EXPOSURE_KEY / adapted, *EXPOSURE_RANGE))
 
+    def _meter_blocks(self) -> np.ndarray:
+        """The meter pass's blocks: (rows, cols, 4) of mean log luminance, its samples, mean linear
+        luminance, its pixels."""
+        return np.frombuffer(self.meter.read(), np.float32).reshape(self._meter_weights.shape + (4,))
+
     def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None,
-               radiance: bool = False) -> RenderedViews:
+               radiance: bool = False, development: Development | None = None) -> RenderedViews:
         """RGB, depth and instance images from an optical frame (rotation columns: x right, y down,
         z forward) in the house frame; ``exposure`` fixes the exposure (None: auto-exposure);
-        ``radiance``: also the HDR target (linear light, before exposure) for a sensor model."""
+        ``radiance``: also the HDR target (linear light, before exposure) for a sensor model;
+        ``development``: the colour image developed through that sensor here (then ``exposure`` is
+        not used)."""
         self._sync()
         ctx = self.ctx
         view = view_matrix(position, rotation)
@@ -750,35 +775,88 @@ class GLRenderer:
         self._draw_view(view, view_proj, position)
         ctx.depth_func = "<"
         ctx.disable(ctx.DEPTH_TEST)
-        return self._develop(exposure, radiance)
+        return self._develop(exposure, radiance, development)
 
-    def _develop(self, exposure: float | None, radiance: bool = False) -> RenderedViews:
-        """The camera's side of a frame already drawn into the HDR target: metering, tone map and
-        read-back (the HDR target too, for ``radiance``); raises RenderError where radiance is not
-        finite (never a silently black frame)."""
+    def _develop(self, exposure: float | None, radiance: bool = False,
+                 development: Development | None = None) -> RenderedViews:
+        """The camera's side of a frame already drawn into the HDR target: metering, then the tone map
+        at the renderer's exposure or the sensor's development, and read-back (the HDR target too,
+        for ``radiance``); raises RenderError where radiance is not finite (never a silently black
+        frame)."""
         self.hdr.use(0)
         self.meter_fbo.use()
         _uniform(self.meter_program, "u_hdr").value = 0
         _uniform(self.meter_program, "u_block").value = METER_BLOCK
         self.gl.draw(self.meter_vao)
         self.gl.finish()                     # waits for the frame without the GIL: read-backs then do not
-        self.ldr_fbo.use()
-        _uniform(self.tonemap_program, "u_hdr").value = 0
-        _uniform(self.tonemap_program, "u_exposure").value = self._exposure() if exposure is None else exposure
-        self.gl.draw(self.tonemap_vao)
-        self.gl.finish()
         h, w = self.height, self.width
-        rgba = np.frombuffer(self.ldr_fbo.read(components=4), np.uint8).reshape(h, w, 4)[::-1]
-        depth = np.frombuffer(self.depth.read(), np.float32).reshape(h, w)[::-1].copy()
         instance = np.frombuffer(self.instance.read(), np.int32).reshape(h, w)[::-1]
-        faulty = rgba[..., 3] < 128
-        if faulty.any():
-            raise RenderError(f"{int(faulty.sum())} pixels of non-finite radiance (instances "
-                              f"{sorted(set(instance[faulty].tolist()))[:8]}) in the frame: a shader fault")
-        rgb = rgba[..., :3]
+        finite = int(self._meter_blocks()[..., 3].sum())          # pixels of finite radiance
+        if finite < h * w:
+            self._refuse_non_finite(instance)
+        depth = np.frombuffer(self.depth.read(), np.float32).reshape(h, w)[::-1].copy()
+        chosen = None
+        if development is None:
+            self.ldr_fbo.use()
+            _uniform(self.tonemap_program, "u_hdr").value = 0
+            _uniform(self.tonemap_program, "u_exposure").value = self._exposure() if exposure is None else exposure
+            self.gl.draw(self.tonemap_vao)
+        else:
+            chosen = self._develop_through(development, depth)
+        self.gl.finish()
+        rgb = np.frombuffer(self.ldr_fbo.read(components=3, alignment=1), np.uint8).reshape(h, w, 3)[::-1]
         background = instance == 0
         depth[background | (depth > self.far)] = np.nan
         linear = None
         if radiance:
-            linear = np.frombuffer(self.hdr.read(), np.float16).reshape(h, w, 4)[::-1, :, :3].astype(np.float32)
-        return RenderedViews(np.ascontiguousarray(rgb), depth, instance.astype(np.uint16), background, linear)
+            linear = self._radiance()[..., :3].astype(np.float32)
+        return RenderedViews(np.ascontiguousarray(rgb), depth, instance.astype(np.uint16), background, linear,
+                             chosen)
+
+    def _radiance(self) -> np.ndarray:
+        """The HDR target, rows top first: (H, W, 4) float16, rgb linear light, a its log luminance."""
+        return np.frombuffer(self.hdr.read(), np.float16).reshape(self.height, self.width, 4)[::-1]
+
+    def _refuse_non_finite(self, instance: np.ndarray) -> None:
+        """Raise RenderError naming the pixels of non-finite radiance the meter left out."""
+        faulty = ~np.isfinite(self._radiance()[..., :3].astype(np.float32)).all(axis=2)
+        raise RenderError(f"{int(faulty.sum())} pixels of non-finite radiance (instances "
+                          f"{sorted(set(instance[faulty].tolist()))[:8]}) in the frame: a shader fault")
+
+    def _develop_through(self, development: Development, depth: np.ndarray) -> Exposure:
+        """The frame in the HDR target developed through a camera sensor into the LDR target, the
+        sensor model deciding (exposure from the metered mean, the motion sweep over that exposure,
+        white balance from the signal's means) and the sensor passes carrying it out per pixel."""
+        sensor = development.sensor
+        blocks = self._meter_blocks()
+        metered = float((blocks[..., 2] * blocks[..., 3]).sum() / max(float(blocks[..., 3].sum()), 1.0))
+        time, gain = sensor.exposure_for(metered)
+        shift, zoom, samples = 0.0, 0.0, 1
+        if any(development.velocity):
+            shift, zoom, samples = sensor.sweep(self.K, development.velocity, time, typical_depth(depth, self.far))
+        seed = development.rng.integers(0, 2 ** 32, size=2, dtype=np.uint64)
+        expose = self.sensor_programs["expose"]
+        values = {"u_hdr": 0, "u_electrons": sensor.sensitivity * time, "u_read_noise": sensor.read_noise,
+                  "u_full_well": sensor.full_well, "u_gain": gain, "u_levels": sensor.levels,
+                  "u_principal": (float(self.K[0, 2]), float(self.K[1, 2])), "u_shift": shift, "u_zoom": zoom,
+                  "u_samples": max(samples, 1), "u_seed": (int(seed[0]), int(seed[1]))}
+        for name, value in values.items():
+            _uniform(expose, name).value = value
+        self.signal_fbo.use()
+        self.gl.draw(self.sensor_vaos["expose"])
+        self.signal.use(0)
+        _uniform(self.sensor_programs["balance"], "u_signal").value = 0
+        _uniform(self.sensor_programs["balance"], "u_block").value = METER_BLOCK
+        self.balance_fbo.use()
+        self.gl.draw(self.sensor_vaos["balance"])
+        self.gl.finish()
+        means = np.frombuffer(self.balance.read(), np.float32).reshape(-1, 4)
+        channel_means = (means[:, :3] * means[:, 3:]).sum(axis=0) / max(float(means[:, 3].sum()), 1.0)
+        balance = sensor.balance_gains(channel_means)
+        develop = self.sensor_programs["develop"]
+        _uniform(develop, "u_signal").value = 0
+        _uniform(develop, "u_balance").value = balance
+        _uniform(develop, "u_output_gain").value = sensor.output_gain
+        self.ldr_fbo.use()
+        self.gl.draw(self.sensor_vaos["develop"])
+        return Exposure(time, gain, float(channel_means.mean()), balance)

@@ -13,7 +13,7 @@ import pybullet as pb
 
 from ravh_sim.render.projection import projection_from_K, view_matrix
 from ravh_sim.render.tiny_lighting import SUN_AMBIENT, SUN_DIFFUSE, Lighting
-from ravh_sim.render.views import RenderedViews
+from ravh_sim.render.views import Development, RenderedViews
 from ravh_sim.world.appearance import lamps_at, sun_light
 from ravh_sim.world.scene import World
 
@@ -31,9 +31,10 @@ class TinyRenderer:
         self.lighting = Lighting(world, K, width, height)
 
     def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None,
-               radiance: bool = False) -> RenderedViews:
+               radiance: bool = False, development: Development | None = None) -> RenderedViews:
         """Views from an optical pose; ``exposure`` is ignored (the lighting pass sets the level), and
-        so is ``radiance`` (no linear light: a sensor model works from the 8-bit image)."""
+        so are ``radiance`` and ``development`` (no linear light: the camera develops the 8-bit image
+        through its sensor model)."""
         state = self.world.state
         sun = sun_light(state.sun_angle)
         view = view_matrix(position, rotation)

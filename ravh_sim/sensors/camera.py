@@ -29,7 +29,7 @@ from ravh_sim.files import atomic_write, encode_png, read_png, write_image
 from ravh_sim.poses import quaternion_from_matrix
 from ravh_sim.render.backend import QUALITIES
 from ravh_sim.render.renderers import make_renderer
-from ravh_sim.render.views import Renderer
+from ravh_sim.render.views import Development, Exposure, Renderer, typical_depth
 from ravh_sim.schema import FINITE, Length, Range, Rate, Strict
 from ravh_sim.sensors import imaging
 from ravh_sim.sensors.mount import (
@@ -163,8 +163,8 @@ class CameraOptions:
     jpeg_roundtrip: bool = False           # rgb shows JPEG artefacts
     pixel_noise: float = 0.0               # Gaussian sigma, 8-bit levels
     distortion: tuple[float, float, float, float, float] | None = None   # plumb-bob k1 k2 p1 p2 k3
-    motion_blur: bool = False
-    exposure: float = 0.02                 # s, for motion blur
+    motion_blur: bool = False              # the ideal camera's blur (a sensor model always blurs)
+    exposure: float = 0.02                 # s, the ideal camera's exposure for that blur
     depth_noise: float = 0.0               # sigma = depth_noise * z^2 (1/m)
     manual_exposure: float | None = None   # GL renderer: a fixed exposure instead of auto-exposure
 
@@ -179,6 +179,7 @@ class Frame:
     position: np.ndarray                   # optical frame origin, house frame
     rotation: np.ndarray                   # optical axes as columns, house frame
     radiance: np.ndarray | None = None     # linear light before exposure (for a sensor model)
+    exposure: Exposure | None = None       # rgb was developed through the camera's sensor, which chose this
 
 
 @dataclass
@@ -249,14 +250,17 @@ class SmartCamera:
         return uv
 
     # ------------------------------------------------------------------ capture
-    def render(self, x: float, y: float, yaw: float, floor_z: float | None = None) -> Frame:
-        """The render from robot pose (x, y, yaw), before effects."""
+    def render(self, x: float, y: float, yaw: float, floor_z: float | None = None,
+               development: Development | None = None) -> Frame:
+        """The render from robot pose (x, y, yaw), before effects; ``development``: the colour image
+        developed through a sensor where the renderer can (Frame.exposure then says so)."""
         position, rotation = self.optical_pose(x, y, yaw, floor_z)
         if self.renderer is None:
             raise RuntimeError("the camera was closed")
-        views = self.renderer.render(position, rotation, self.options.manual_exposure, self.sensor is not None)
+        views = self.renderer.render(position, rotation, self.options.manual_exposure,
+                                     self.sensor is not None and development is None, development)
         return Frame(views.rgb, views.depth, views.instance, views.background, position, rotation,
-                     views.radiance)
+                     views.radiance, views.exposure)
 
     def take_index(self) -> int:
         """The next capture number, used up: a frame due but not rendered (nobody listening) takes
@@ -270,18 +274,22 @@ class SmartCamera:
         ``index``: a number taken earlier with :meth:`take_index` (None: the next one)."""
         opts = self.options
         index = self.take_index() if index is None else index
-        frame = self.render(x, y, yaw, floor_z)
-        rgb, depth, instance = frame.rgb, frame.depth, frame.instance
         rng = noise_rng(self.world.state.seed, NOISE_STREAM, self.agent, index)
-        blur = velocity if opts.motion_blur else (0.0, 0.0)
-        # how far the scene is sets how much a motion blurs it (a median over the frame: only for a blur)
-        distance = float(np.nanmedian(depth)) if any(blur) and np.isfinite(depth).any() else self.spec.far
-        if self.sensor is not None:          # exposure, blur over it, noise, white balance, clipping
+        # a sensor always blurs over the exposure it chose; the ideal camera where the profile asks
+        blur = velocity if opts.motion_blur or self.sensor is not None else (0.0, 0.0)
+        # exposure, blur over it, noise, white balance, clipping: where the frame is drawn if the
+        # renderer can, else here from its radiance (or its 8-bit image, TinyRenderer)
+        development = Development(self.sensor, rng, blur) if self.sensor is not None else None
+        frame = self.render(x, y, yaw, floor_z, development)
+        rgb, depth, instance = frame.rgb, frame.depth, frame.instance
+        # how far the scene is sets how much a forward motion blurs it (only needed for a blur)
+        distance = typical_depth(depth, self.spec.far) if any(blur) else self.spec.far
+        if self.sensor is not None and frame.exposure is None:
             if frame.radiance is not None:
                 rgb, _ = self.sensor.expose(frame.radiance, rng, self.K, blur, distance)
             else:
                 rgb, _ = self.sensor.from_rendered(rgb, rng, self.K, blur, distance)
-        elif any(blur):
+        elif self.sensor is None and any(blur):
             rgb = imaging.motion_blur(rgb, self.K, velocity[0], velocity[1], opts.exposure, distance)
         if self._lens is not None:
             rgb = self._lens.apply(rgb)

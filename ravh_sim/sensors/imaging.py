@@ -17,6 +17,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from ravh_sim.render.views import Exposure
+
 MAX_BLUR_SAMPLES = 9
 DEPTH_SCALE = 1000.0                   # depth PNG units per metre (16-bit millimetres)
 DEPTH_MAX_M = 65.535                   # deepest representable depth; farther is stored as 0
@@ -52,26 +54,34 @@ def depth_noise(depth: np.ndarray, coeff: float, rng: np.random.Generator) -> np
 
 def motion_blur(rgb: np.ndarray, K: np.ndarray, linear: float, angular: float, exposure: float,
                 distance: float) -> np.ndarray:
-    """Blur from the robot moving during the exposure.
-
-    Turning at ``angular`` rad/s sweeps the image sideways by fx * angular * exposure pixels; driving
-    at ``linear`` m/s zooms it about the principal point by linear * exposure / ``distance`` (the
-    scene's typical depth). The image is the mean of copies along that sweep, centred on the pose.
-    """
-    blurred = _sweep(rgb, K, linear, angular, exposure, distance)
+    """Blur from the robot moving during the exposure (the ideal camera's fixed ``exposure``; a
+    sensor model blurs over the exposure its auto-exposure chose). See :func:`sweep`."""
+    blurred = _swept(rgb, sweep(K, (linear, angular), exposure, distance), K)
     return rgb if blurred is None else np.clip(blurred + 0.5, 0, 255).astype(np.uint8)
 
 
-def _sweep(image: np.ndarray, K: np.ndarray, linear: float, angular: float, exposure: float,
-           distance: float) -> np.ndarray | None:
-    """float32 mean of ``image`` along the motion sweep of :func:`motion_blur` (None: under a pixel)."""
+def sweep(K: np.ndarray, velocity: tuple[float, float], exposure: float, distance: float
+          ) -> tuple[float, float, int]:
+    """(sideways shift px, zoom, samples) of the motion blur over ``exposure`` s.
+
+    Turning at ``velocity[1]`` rad/s sweeps the image sideways by fx * w * exposure pixels; driving at
+    ``velocity[0]`` m/s zooms it about the principal point by v * exposure / ``distance`` (the
+    scene's typical depth). The image is the mean of ``samples`` copies along that sweep, centred on
+    the pose, one a pixel of the sweep's reach (at most MAX_BLUR_SAMPLES; under 2: no blur).
+    """
     fx, cx, cy = K[0, 0], K[0, 2], K[1, 2]
-    shift = fx * angular * exposure
-    zoom = linear * exposure / max(distance, 0.1)
+    shift = float(fx * velocity[1] * exposure)
+    zoom = float(velocity[0] * exposure / max(distance, 0.1))
     reach = max(abs(shift), abs(zoom) * math.hypot(cx, cy))
-    samples = min(MAX_BLUR_SAMPLES, int(math.ceil(reach)) + 1)
+    return shift, zoom, min(MAX_BLUR_SAMPLES, int(math.ceil(reach)) + 1)
+
+
+def _swept(image: np.ndarray, swept: tuple[float, float, int], K: np.ndarray) -> np.ndarray | None:
+    """float32 mean of ``image`` along a :func:`sweep` (None: under a pixel, no blur)."""
+    shift, zoom, samples = swept
     if samples < 2:
         return None
+    cx, cy = K[0, 2], K[1, 2]
     acc = np.zeros(image.shape, np.float32)
     h, w = image.shape[:2]
     for t in np.linspace(-0.5, 0.5, samples):
@@ -90,27 +100,23 @@ LUMA = np.array([0.2126, 0.7152, 0.0722], np.float32)       # Rec. 709 luminance
 
 
 @dataclass(frozen=True)
-class Exposure:
-    """What the auto-exposure chose for one frame, and what came of it."""
-    time: float               # s
-    gain: float               # analogue gain (1 = base ISO)
-    signal: float             # mean of the image in full-scale units (the AE's target when reachable)
-    white_balance: tuple[float, float, float]    # per-channel gains applied
-
-
-@dataclass(frozen=True)
 class SensorModel:
     """A camera sensor and its image pipeline. Units: radiance in the renderer's linear light units,
     charge in electrons (e-).
 
     Auto-exposure meters the mean luminance and asks for ``target`` of full scale: it lengthens the
     exposure up to ``exposure_max`` first (longer frames blur), then raises the gain up to ``gain_max``;
-    past both the image stays dark. The pixel collects radiance * sensitivity * time electrons, with
-    photon shot noise (Poisson, sqrt of the charge) and ``read_noise``, clips at ``full_well``; the gain
-    amplifies signal and noise alike and the ADC clips and quantises to ``adc_bits``. So noise relative
-    to signal grows as light falls (fewer electrons, more gain). White balance is grey-world, limited to
-    ``white_balance_limit``; the output is the renderer's ACES curve and sRGB encoding. The default
-    sensitivity makes a daylit room a 1/100 s exposure at gain 1.
+    past both the image stays dark. The robot's motion blurs the image over the exposure time. The
+    pixel collects radiance * sensitivity * time electrons, with photon shot noise (Poisson, sqrt of
+    the charge) and ``read_noise``, clips at ``full_well``; the gain amplifies signal and noise alike
+    and the ADC clips and quantises to ``adc_bits``. So noise relative to signal grows as light falls
+    (fewer electrons, more gain). White balance is grey-world, limited to ``white_balance_limit``; the
+    output is the renderer's ACES curve and sRGB encoding. The default sensitivity makes a daylit room
+    a 1/100 s exposure at gain 1.
+
+    :meth:`expose` is the reference in numpy; the GL renderer runs the same steps in its shaders
+    (render/shaders/sensor_*.frag) with this model's decisions (:meth:`exposure_for`,
+    :meth:`balance_gains`, :meth:`sweep`), so a frame never leaves the device before it is an image.
     """
     exposure_min: float = 1e-4
     exposure_max: float = 1 / 30
@@ -124,12 +130,38 @@ class SensorModel:
     white_balance_limit: float = 2.0
     reference_exposure: float = 1.0     # the renderer's fixed exposure of the frames fed to from_rendered
 
-    def auto_exposure(self, radiance: np.ndarray) -> tuple[float, float]:
-        """(exposure time s, gain) for a (H, W, 3) linear radiance image."""
-        metered = max(float(np.mean(radiance @ LUMA)), 1e-9)
-        wanted = self.target * self.full_well / (metered * self.sensitivity)      # time * gain
+    @property
+    def levels(self) -> float:
+        """The ADC's largest code."""
+        return float(2 ** self.adc_bits - 1)
+
+    @property
+    def output_gain(self) -> float:
+        """Full-scale signal to the tone curve's input: the AE's target lands on the renderer's mid-grey."""
+        return 0.2 / self.target
+
+    def exposure_for(self, metered: float) -> tuple[float, float]:
+        """(exposure time s, gain) for a frame whose mean linear luminance is ``metered``."""
+        wanted = self.target * self.full_well / (max(metered, 1e-9) * self.sensitivity)     # time * gain
         time = float(np.clip(wanted, self.exposure_min, self.exposure_max))
         return time, float(np.clip(wanted / time, 1.0, self.gain_max))
+
+    def auto_exposure(self, radiance: np.ndarray) -> tuple[float, float]:
+        """(exposure time s, gain) for a (H, W, 3) linear radiance image."""
+        return self.exposure_for(float(np.mean(radiance @ LUMA)))
+
+    def balance_gains(self, means: np.ndarray) -> tuple[float, float, float]:
+        """Grey-world gains for an image of per-channel means ``means`` (ones when balance is off)."""
+        if not self.white_balance:
+            return 1.0, 1.0, 1.0
+        means = np.maximum(np.asarray(means, np.float64), 1e-6)
+        red, green, blue = np.clip(means[1] / means, 1 / self.white_balance_limit, self.white_balance_limit)
+        return float(red), float(green), float(blue)
+
+    def sweep(self, K: np.ndarray, velocity: tuple[float, float], time: float, distance: float
+              ) -> tuple[float, float, int]:
+        """The motion blur over an exposure of ``time`` s (module :func:`sweep`)."""
+        return sweep(K, velocity, time, distance)
 
     def expose(self, radiance: np.ndarray, rng: np.random.Generator, K: np.ndarray | None = None,
                velocity: tuple[float, float] = (0.0, 0.0), distance: float = 2.0) -> tuple[np.ndarray, Exposure]:
@@ -138,23 +170,19 @@ class SensorModel:
         radiance = np.asarray(radiance, np.float32)
         time, gain = self.auto_exposure(radiance)
         if K is not None and any(velocity):
-            blurred = _sweep(radiance, K, velocity[0], velocity[1], time, distance)
+            blurred = _swept(radiance, self.sweep(K, velocity, time, distance), K)
             radiance = radiance if blurred is None else blurred
         electrons = np.maximum(radiance, 0) * np.float32(self.sensitivity * time)
         electrons = rng.poisson(electrons).astype(np.float32)                      # photon shot noise
         electrons += rng.standard_normal(electrons.shape, dtype=np.float32) * np.float32(self.read_noise)
         signal = np.clip(electrons, 0, self.full_well) * np.float32(gain / self.full_well)
-        levels = float(2 ** self.adc_bits - 1)
-        signal = np.round(np.clip(signal, 0, 1) * levels) / np.float32(levels)
-        balance = (1.0, 1.0, 1.0)
-        if self.white_balance:
-            means = np.maximum(signal.reshape(-1, 3).mean(axis=0), 1e-6)
-            gains = np.clip(means[1] / means, 1 / self.white_balance_limit, self.white_balance_limit)
-            signal = np.minimum(signal * gains.astype(np.float32), 1.0)
-            balance = (float(gains[0]), float(gains[1]), float(gains[2]))
-        out = srgb_encode(aces(signal * np.float32(0.2 / self.target)))
+        signal = np.round(np.clip(signal, 0, 1) * self.levels) / np.float32(self.levels)
+        means = signal.reshape(-1, 3).mean(axis=0)
+        balance = self.balance_gains(means)
+        balanced = np.minimum(signal * np.asarray(balance, np.float32), 1.0)
+        out = srgb_encode(aces(balanced * np.float32(self.output_gain)))
         rgb = np.clip(out * 255 + 0.5, 0, 255).astype(np.uint8)
-        return rgb, Exposure(time, gain, float(np.mean(signal)), balance)
+        return rgb, Exposure(time, gain, float(np.mean(means)), balance)
 
     def from_rendered(self, rgb: np.ndarray, rng: np.random.Generator, K: np.ndarray | None = None,
                       velocity: tuple[float, float] = (0.0, 0.0), distance: float = 2.0

@@ -100,3 +100,13 @@ vec3 window_light(vec3 p, vec3 n, float span) {
 float luminance(vec3 c) {
     return dot(c, vec3(0.2126, 0.7152, 0.0722));
 }
+
+// The camera response shared by the renderer's own tone map and the sensor's development:
+// Narkowicz's ACES fit (linear in, display-linear [0, 1] out) and the sRGB transfer curve.
+vec3 aces(vec3 x) {
+    return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
+}
+
+vec3 srgb_encode(vec3 c) {
+    return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+}

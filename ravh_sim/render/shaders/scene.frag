@@ -22,7 +22,8 @@ uniform sampler2D u_room_map;         // floor plan: room index + 1 per cell, 0 
 uniform vec4 u_room_box;              // x0, y0, 1/width, 1/height in metres
 uniform sampler2D u_room_light;       // rooms x 1: sky and bounce light of each room
 uniform sampler2DShadow u_sun_shadow;
-uniform sampler2D u_point_shadow;     // atlas: 6 faces per row, one row per shadowed lamp
+uniform sampler2DShadow u_point_shadow;  // atlas: 6 faces per row, one row per shadowed lamp (distance
+                                         // over LAMP_SHADOW_RANGE), bilinear 2 x 2 comparisons
 uniform sampler2D u_coverage;         // blurred top-down coverage (ambient occlusion on floors)
 uniform mat4 u_sun_matrix;
 uniform vec3 u_sun_irradiance;
@@ -250,12 +251,7 @@ vec2 cube_texel(vec3 d, float row, float tile) {
 float lamp_shadow(float row, vec3 d) {
     vec2 texel = cube_texel(d, row, u_tile);
     float reach = length(d) - 0.01 - 0.005 * length(d);
-    float lit = 0.0;
-    lit += step(reach, texture(u_point_shadow, (texel + vec2(-0.7, -0.3)) / u_atlas_texels).r);
-    lit += step(reach, texture(u_point_shadow, (texel + vec2(0.3, -0.7)) / u_atlas_texels).r);
-    lit += step(reach, texture(u_point_shadow, (texel + vec2(0.7, 0.3)) / u_atlas_texels).r);
-    lit += step(reach, texture(u_point_shadow, (texel + vec2(-0.3, 0.7)) / u_atlas_texels).r);
-    return lit * 0.25;
+    return texture(u_point_shadow, vec3(texel / u_atlas_texels, reach / LAMP_SHADOW_RANGE));
 }
 
 // What a mirror-like surface at p reflects along r: the room's probe (a cube map rendered from the

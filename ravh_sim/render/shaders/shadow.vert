@@ -1,5 +1,5 @@
 // Shadow casters: the sun's orthographic map (u_origin = 0) or one cube face of a lamp (u_origin =
-// the lamp, the fragment writes the distance to it). Window glass casts no shadow.
+// the lamp, the fragment's depth is the distance to it). Window glass casts no shadow.
 uniform mat4 u_matrix;
 uniform vec3 u_origin;
 in vec3 in_position;
