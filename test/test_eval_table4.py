@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -11,7 +12,7 @@ from ravh_sim.dataset.api import Dataset
 from ravh_sim.errors import UserError
 from ravh_sim.eval.descriptors import describe, gradient_grid
 from ravh_sim.eval.localization import Localizer, errors, noisy_odometry
-from ravh_sim.eval.table4 import QUICK, RUNS, draw_table4, run_table4
+from ravh_sim.eval.table4 import MAPS, QUICK, ROUTES, RUNS, draw_table4, light_switches, run_table4
 
 
 @pytest.fixture(scope="module")
@@ -34,6 +35,36 @@ def test_quick_table(quick_run):
     for route in doc["routes"].values():
         assert route["images"] >= 10 and route["length_m"] > 2.0
     assert (quick_run / "table4.png").stat().st_size > 5_000 and (quick_run / "table4.txt").exists()
+
+
+def test_the_night_recordings_were_lit_as_two_evenings(quick_run, houses):
+    """The quick run's night map and night route switched the lights their draws say, and the
+    worlds they were recorded in had exactly those lights on."""
+    doc = json.loads((quick_run / "table4.json").read_text())
+    assert doc["protocol"]["night_lights"] == "evening" and doc["house_lights"] == len(houses[20].lights)
+    night_map, night_route = "maps/" + QUICK.maps[1].folder, "routes/" + QUICK.routes[1].folder
+    assert set(doc["night_lights_on"]) == {night_map, night_route}
+    for recording in (night_map, night_route):
+        light = QUICK.maps[1] if recording.startswith("maps") else QUICK.routes[1]
+        drawn = light_switches(houses[20], QUICK, light, recording, 0)
+        lights = Dataset(quick_run / recording).settings.lights
+        assert lights == {k: state == "on" for k, state in drawn.items()}
+        assert doc["night_lights_on"][recording] == sum(lights.values())
+
+
+def test_each_night_is_an_evening_of_its_own(houses):
+    house = houses[15]
+    day, night_map, night_route = ROUTES[0], MAPS[2], ROUTES[2]
+    assert light_switches(house, QUICK, day, "routes/" + day.folder, 0) == {}
+    assert light_switches(house, replace(QUICK, night_lights="all"), night_map, "maps/x", 0) == {}
+    a = light_switches(house, QUICK, night_map, "maps/" + night_map.folder, 0)
+    assert a == light_switches(house, QUICK, night_map, "maps/" + night_map.folder, 0)        # seeded
+    assert set(a) == {lt.id for lt in house.lights}
+    assert a != light_switches(house, QUICK, night_route, "routes/" + night_route.folder, 0)
+    assert a != light_switches(house, QUICK, night_map, "maps/" + night_map.folder, 1)
+    evenings = [light_switches(house, QUICK, night_map, f"maps/{i}", 0) for i in range(40)]
+    share = np.mean([state == "on" for evening in evenings for state in evening.values()])
+    assert 0.4 < share < 0.6                                             # a fair coin per light
 
 
 def test_route_equal_to_a_map_trajectory_has_near_zero_error(quick_run):

@@ -46,6 +46,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--descriptor", default=None,
                    help="'module:function' (RGB image -> vector); default: the gradient_grid baseline")
     p.add_argument("--seed", type=int, default=0, help="seed of the recordings and the odometry noise")
+    p.add_argument("--night-lights", choices=("evening", "all"), default="evening",
+                   help="night recordings: evening (default: each its own fair coin per light, as a home on "
+                        "different evenings) or all (every ceiling light on)")
     p.set_defaults(func=cmd_eval_localization)
 
 
@@ -101,10 +104,13 @@ def _paper_protocol(args: argparse.Namespace, threshold: float, paper_path: Path
 
 
 def cmd_eval_localization(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
     from ravh_sim.eval.table4 import FULL, QUICK, format_table4, run_table4
     from ravh_sim.world.house import load_house
     load_house(args.house)                            # unknown house: the usual clear error
-    doc = run_table4(args.house, args.out, QUICK if args.quick else FULL, args.descriptor, args.seed,
+    protocol = replace(QUICK if args.quick else FULL, night_lights=args.night_lights)
+    doc = run_table4(args.house, args.out, protocol, args.descriptor, args.seed,
                      progress=lambda text: print(text, file=sys.stderr, flush=True))
     print(format_table4(doc))
     print(f"wrote {args.out / 'table4.json'} and {args.out / 'table4.png'}")

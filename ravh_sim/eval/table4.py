@@ -4,7 +4,11 @@ Maps are Grid raids (nodes every 0.5 m, 10 images per node) under the map lighti
 Wanderer raids (about :attr:`Protocol.route_m` metres, an image every :attr:`Protocol.capture_period`
 s) under the route lightings. Lighting is the sun angle l_a (degrees: 90 noon, 180 sunset, > 180
 night) with the rest of config/default.yaml (ceiling lights on, lamps off, default paint and
-models), so only the light differs between a route and a map. The CI-sized protocol
+models), so only the light differs between a route and a map. At night a home has the lights its
+people switched on that evening, not every light in the house: under :attr:`Protocol.night_lights`
+``"evening"`` (the default) each night recording draws every light on or off by a fair coin, a
+draw of its own (another evening), while ``"all"`` keeps every ceiling light on (the paper's raid-4
+preset without its lamps: the night looks like the day, see the README). The CI-sized protocol
 (:data:`QUICK`) keeps two maps and two short routes; its maps hold only the grid nodes along the
 first route, captured in place. Every recording is an ordinary
 dataset under ``OUT/maps/`` and ``OUT/routes/``; a later run reuses recordings made with the same
@@ -16,6 +20,7 @@ from __future__ import annotations
 
 import json
 import math
+import random
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -33,6 +38,7 @@ from ravh_sim.eval.descriptors import Descriptor, describe, load_descriptor
 from ravh_sim.eval.localization import Localizer, errors, noisy_odometry
 from ravh_sim.raids.direct import MAX_SIM_S, GridSpec, PosesSpec, WandererSpec, record
 from ravh_sim.viz.figure import figure_bgr, new_figure
+from ravh_sim.world.house import House, load_house
 
 RUNS = 5
 SPEED = 0.25                       # m/s, the Wanderer's cruise speed (the giraff profile's maximum)
@@ -69,8 +75,11 @@ class Protocol:
     capture_period: float = 1.0    # s between route images
     map_near_route_m: float = 0.0  # > 0: the map is only the grid nodes this close to the first
                                    # route, captured in place (scripted poses): the CI-sized map
+    night_lights: str = "evening"  # evening: each night recording its own coin per light | all:
+                                   # every ceiling light on, lamps off (the settings' default)
 
 
+NIGHT_LIGHTS = ("evening", "all")
 FULL = Protocol()
 QUICK = Protocol(maps=MAPS[::2], routes=(ROUTES[0], ROUTES[2]), route_m=8.0, map_near_route_m=0.5)
 
@@ -85,10 +94,20 @@ def run_table4(house: int, out: Path, protocol: Protocol = FULL, descriptor: str
     say = progress or (lambda _: None)
     started = time.monotonic()
     route_spec, route_s = WandererSpec("once", protocol.capture_period, seed), protocol.route_m / SPEED
-    routes = {r: _recording(out / "routes" / r.folder, house, r, route_spec, route_s, seed, say)
-              for r in protocol.routes}
+    if protocol.night_lights not in NIGHT_LIGHTS:
+        raise UserError(f"night lights must be one of {', '.join(NIGHT_LIGHTS)}, got {protocol.night_lights!r}")
+    home = load_house(house)
+    lit: dict[str, int] = {}                  # lights on in each night recording (role/folder)
+
+    def recording(role: str, light: Lighting, spec: GridSpec | WandererSpec | PosesSpec, sim_s: float) -> Dataset:
+        switches = light_switches(home, protocol, light, f"{role}/{light.folder}", seed)
+        if switches:
+            lit[f"{role}/{light.folder}"] = sum(state == "on" for state in switches.values())
+        return _recording(out / role / light.folder, house, light, switches, spec, sim_s, seed, say)
+
+    routes = {r: recording("routes", r, route_spec, route_s) for r in protocol.routes}
     map_spec = _map_spec(protocol, routes[protocol.routes[0]])
-    maps = {m: _recording(out / "maps" / m.folder, house, m, map_spec, 0.0, seed, say) for m in protocol.maps}
+    maps = {m: recording("maps", m, map_spec, 0.0) for m in protocol.maps}
     recorded = time.monotonic()
     say("describing images")
     map_side = {m: _described(ds, function) for m, ds in maps.items()}
@@ -109,7 +128,7 @@ def run_table4(house: int, out: Path, protocol: Protocol = FULL, descriptor: str
                         "runs": [{"position_m": round(p, 3), "rotation_deg": round(a, 2)} for p, a in runs]})
         cells.append(row)
     doc = {"house": house, "descriptor": name, "seed": seed, "runs": RUNS,
-           "protocol": _protocol_doc(protocol),
+           "protocol": _protocol_doc(protocol), "house_lights": len(home.lights), "night_lights_on": lit,
            "maps": {m.label: {"images": len(maps[m]), "dataset": str(maps[m].dir)} for m in protocol.maps},
            "routes": {r.label: {"images": len(routes[r]), "length_m": round(_length(route_side[r][1]), 2),
                                 "dataset": str(routes[r].dir)} for r in protocol.routes},
@@ -136,20 +155,35 @@ def _map_spec(protocol: Protocol, route: Dataset) -> GridSpec | PosesSpec:
     return PosesSpec(tuple((x, y, 2 * math.pi * i / k) for x, y in near for i in range(k)))
 
 
-def _recording(folder: Path, house: int, light: Lighting, behaviour: GridSpec | WandererSpec | PosesSpec,
-               max_sim_s: float, seed: int, say: Callable[[str], None]) -> Dataset:
+def light_switches(house: House, protocol: Protocol, light: Lighting, recording: str, seed: int
+                   ) -> dict[str, str]:
+    """The lights one recording switches away from the settings' (ceiling on, lamps off): none by
+    day and at sunset; at night, under ``evening``, every light of the house on or off by a fair
+    coin from the recording's own stream (``recording`` names it: maps/night_200), so a route and a
+    map are two evenings with other rooms lit."""
+    if light.sun_angle <= 180.0 or protocol.night_lights == "all":
+        return {}
+    coin = random.Random(f"{seed}/table4/evening/{recording}")
+    return {lt.id: "on" if coin.random() < 0.5 else "off" for lt in house.lights}
+
+
+def _recording(folder: Path, house: int, light: Lighting, switches: dict[str, str],
+               behaviour: GridSpec | WandererSpec | PosesSpec, max_sim_s: float, seed: int,
+               say: Callable[[str], None]) -> Dataset:
     """The dataset of one map or route: reused if recorded before with the same request."""
     limits = {"max_sim_s": max_sim_s} if max_sim_s > 0 else {}
+    lights = {"lights": switches} if switches else {}
     request = json.loads(json.dumps({"benchmark": "table4", "house": house, "sun_angle": light.sun_angle,
                                      "seed": seed, "behaviour": behaviour.name, "spec": asdict(behaviour),
-                                     **limits}))
+                                     **lights, **limits}))
     summary_path = folder / RAID_JSON
     if summary_path.exists():
         if json.loads(summary_path.read_text()).get("request") == request:
             return Dataset(folder)
         raise UserError(f"{folder} holds a recording of other settings; use another --out or remove it")
     say(f"recording {behaviour.name} {light.label} into {folder}")
-    summary = record(folder, house, behaviour, settings={"lights": {"sun_angle": light.sun_angle}}, seed=seed,
+    settings = {"lights": {"sun_angle": light.sun_angle, "set": switches}}
+    summary = record(folder, house, behaviour, settings=settings, seed=seed,
                      raid={"request": request}, max_sim_s=max_sim_s if max_sim_s > 0 else MAX_SIM_S)
     if not summary["captures"]:
         raise UserError(f"{folder}: the {behaviour.name} recorded no images ({summary['status']})")
@@ -175,8 +209,9 @@ def _protocol_doc(protocol: Protocol) -> dict[str, Any]:
 def format_table4(doc: dict[str, Any]) -> str:
     """Routes x maps: median position error (m) / rotation error (deg)."""
     maps = list(doc["maps"])
+    night = doc["protocol"].get("night_lights", "all")
     lines = [f"House {doc['house']}, descriptor {doc['descriptor']}: median position (m) / rotation (deg) "
-             f"error, median of {doc['runs']} runs",
+             f"error, median of {doc['runs']} runs; night lights: {night}",
              f"{'route / map':<14}" + "".join(f"{m:>18}" for m in maps)]
     for row in doc["cells"]:
         lines.append(f"{row[0]['route']:<14}" + "".join(f"{c['position_m']:>10.2f} / {c['rotation_deg']:>5.1f}"
