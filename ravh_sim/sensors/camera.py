@@ -178,7 +178,6 @@ class Frame:
     background: np.ndarray                 # (H, W) bool, no body (sky)
     position: np.ndarray                   # optical frame origin, house frame
     rotation: np.ndarray                   # optical axes as columns, house frame
-    radiance: np.ndarray | None = None     # linear light before exposure (for a sensor model)
     exposure: Exposure | None = None       # rgb was developed through the camera's sensor, which chose this
 
 
@@ -257,10 +256,8 @@ class SmartCamera:
         position, rotation = self.optical_pose(x, y, yaw, floor_z)
         if self.renderer is None:
             raise RuntimeError("the camera was closed")
-        views = self.renderer.render(position, rotation, self.options.manual_exposure,
-                                     self.sensor is not None and development is None, development)
-        return Frame(views.rgb, views.depth, views.instance, views.background, position, rotation,
-                     views.radiance, views.exposure)
+        views = self.renderer.render(position, rotation, self.options.manual_exposure, development=development)
+        return Frame(views.rgb, views.depth, views.instance, views.background, position, rotation, views.exposure)
 
     def take_index(self) -> int:
         """The next capture number, used up: a frame due but not rendered (nobody listening) takes
@@ -278,19 +275,15 @@ class SmartCamera:
         # a sensor always blurs over the exposure it chose; the ideal camera where the profile asks
         blur = velocity if opts.motion_blur or self.sensor is not None else (0.0, 0.0)
         # exposure, blur over it, noise, white balance, clipping: where the frame is drawn if the
-        # renderer can, else here from its radiance (or its 8-bit image, TinyRenderer)
+        # renderer can, else here from its 8-bit image (TinyRenderer)
         development = Development(self.sensor, rng, blur) if self.sensor is not None else None
         frame = self.render(x, y, yaw, floor_z, development)
         rgb, depth, instance = frame.rgb, frame.depth, frame.instance
-        # how far the scene is sets how much a forward motion blurs it (only needed for a blur)
-        distance = typical_depth(depth, self.spec.far) if any(blur) else self.spec.far
         if self.sensor is not None and frame.exposure is None:
-            if frame.radiance is not None:
-                rgb, _ = self.sensor.expose(frame.radiance, rng, self.K, blur, distance)
-            else:
-                rgb, _ = self.sensor.from_rendered(rgb, rng, self.K, blur, distance)
+            rgb, _ = self.sensor.from_rendered(rgb, rng, self.K, blur, typical_depth(depth, self.spec.far))
         elif self.sensor is None and any(blur):
-            rgb = imaging.motion_blur(rgb, self.K, velocity[0], velocity[1], opts.exposure, distance)
+            rgb = imaging.motion_blur(rgb, self.K, velocity[0], velocity[1], opts.exposure,
+                                      typical_depth(depth, self.spec.far))
         if self._lens is not None:
             rgb = self._lens.apply(rgb)
             depth = self._lens.apply(depth, nearest=True, fill=np.nan)
