@@ -8,6 +8,7 @@ window, a warm cast, a sharp edge for the blur.
 """
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 from conftest import resolved
@@ -15,6 +16,8 @@ from conftest import resolved
 from ravh_sim.render.backend import resolve_backend
 from ravh_sim.render.gl_renderer import GLRenderer
 from ravh_sim.render.views import Development
+from ravh_sim.robot.profile import load_profile
+from ravh_sim.sensors.camera import PORT
 from ravh_sim.sensors.imaging import DAYLIT_LUMINANCE, SensorModel
 from ravh_sim.world.scene import World
 
@@ -122,3 +125,20 @@ def test_turning_blurs_the_frame_as_much_as_the_reference_does(renderer):
     assert abs(width - reference_width) <= 1 and abs(at - reference_at) <= 0.5
     assert width >= 5                                                    # 548 px/rad * 0.44 rad/s * 1/30 s = 8 px
     assert chosen.time == pytest.approx(sensor.exposure_max)
+
+
+def test_the_robots_camera_develops_on_the_device_and_blurs_when_it_turns(houses):
+    """The giraff camera as the sim builds it: its frames come developed by the renderer (no numpy
+    sensor), and its sensor blurs them whenever the robot moves (no profile switch needed)."""
+    house = houses[15]
+    with World(house, resolved(house), renderer="gl") as world:
+        camera = PORT.build(world, load_profile().camera, "robot")
+        x, y, yaw = house.station.position[0], house.station.position[1], house.station.yaw
+        still = camera.capture(x, y, yaw, index=0)
+        turning = camera.capture(x, y, yaw, velocity=(0.0, np.radians(25)), index=0)
+        frame = camera.render(x, y, yaw, development=Development(camera.sensor, np.random.default_rng(0)))
+        camera.close()
+    assert frame.exposure is not None and frame.exposure.time > 0
+    sharpness = [cv2.Laplacian(cv2.cvtColor(c.rgb, cv2.COLOR_RGB2GRAY), cv2.CV_64F).var() for c in (still, turning)]
+    assert sharpness[1] < 0.7 * sharpness[0]
+    assert np.array_equal(still.depth, turning.depth, equal_nan=True)      # the blur is the image's alone
