@@ -92,12 +92,12 @@ def test_a_nan_pixel_neither_meters_nor_is_stored(black_view_world):
     renderer = camera.renderer
     assert isinstance(renderer, GLRenderer)
     clean = camera.render(*WAS_BLACK[1]).rgb
-    exposure = renderer._exposure()
+    exposure = renderer._exposure(renderer._meter_blocks())
     hdr = np.frombuffer(renderer.hdr.read(), np.float16).reshape(renderer.height, renderer.width, 4).copy()
     hdr[100, 200] = np.nan
     renderer.hdr.write(hdr.tobytes())
     with pytest.raises(RenderError, match="1 pixels of non-finite radiance"):
         renderer._develop(None)
-    assert math.isfinite(renderer._exposure())
-    assert renderer._exposure() == pytest.approx(exposure, rel=0.01)
+    assert math.isfinite(renderer._exposure(renderer._meter_blocks()))
+    assert renderer._exposure(renderer._meter_blocks()) == pytest.approx(exposure, rel=0.01)
     assert clean.mean() > MEAN_LUMA[0]

@@ -738,13 +738,13 @@ class GLRenderer:
         _uniform(self.sky_program, "u_inverse_view_proj").write(_mat(np.linalg.inv(view_proj)))
         self.gl.draw(self.empty_vao)
 
-    def _exposure(self) -> float:
+    def _exposure(self, blocks: np.ndarray) -> float:
         """Auto-exposure as a camera's centre-weighted metering: the log luminance of the frame,
         the middle weighted CENTRE_WEIGHT times the edges, is brought part of the way to mid-grey
         (a camera keeps a dusk room dimmer than a noon one), within the camera's range (so a dark
         room stays dark instead of turning grey). Highlights count at most METER_HIGHLIGHT above
-        the median, so a bright window clips to white while the room is exposed for, as in a photo."""
-        blocks = self._meter_blocks()
+        the median, so a bright window clips to white while the room is exposed for, as in a photo.
+        ``blocks``: the meter pass's (:meth:`_meter_blocks`)."""
         weights = blocks[..., 1] * self._meter_weights + 1e-9
         log_luminance = np.minimum(blocks[..., 0], np.median(blocks[..., 0]) + METER_HIGHLIGHT)
         average = math.exp(float(np.average(log_luminance, weights=weights)))
@@ -791,18 +791,19 @@ class GLRenderer:
         self.gl.finish()                     # waits for the frame without the GIL: read-backs then do not
         h, w = self.height, self.width
         instance = np.frombuffer(self.instance.read(), np.int32).reshape(h, w)[::-1]
-        finite = int(self._meter_blocks()[..., 3].sum())          # pixels of finite radiance
-        if finite < h * w:
+        blocks = self._meter_blocks()
+        if int(blocks[..., 3].sum()) < h * w:                       # pixels of finite radiance
             self._refuse_non_finite(instance)
         depth = np.frombuffer(self.depth.read(), np.float32).reshape(h, w)[::-1].copy()
         chosen = None
         if development is None:
             self.ldr_fbo.use()
             _uniform(self.tonemap_program, "u_hdr").value = 0
-            _uniform(self.tonemap_program, "u_exposure").value = self._exposure() if exposure is None else exposure
+            chosen_exposure = self._exposure(blocks) if exposure is None else exposure
+            _uniform(self.tonemap_program, "u_exposure").value = chosen_exposure
             self.gl.draw(self.tonemap_vao)
         else:
-            chosen = self._develop_through(development, depth)
+            chosen = self._develop_through(development, blocks, depth)
         self.gl.finish()
         rgb = np.frombuffer(self.ldr_fbo.read(components=3, alignment=1), np.uint8).reshape(h, w, 3)[::-1]
         background = instance == 0
@@ -823,12 +824,12 @@ class GLRenderer:
         raise RenderError(f"{int(faulty.sum())} pixels of non-finite radiance (instances "
                           f"{sorted(set(instance[faulty].tolist()))[:8]}) in the frame: a shader fault")
 
-    def _develop_through(self, development: Development, depth: np.ndarray) -> Exposure:
+    def _develop_through(self, development: Development, blocks: np.ndarray, depth: np.ndarray) -> Exposure:
         """The frame in the HDR target developed through a camera sensor into the LDR target, the
         sensor model deciding (exposure from the metered mean, the motion sweep over that exposure,
-        white balance from the signal's means) and the sensor passes carrying it out per pixel."""
+        white balance from the signal's means) and the sensor passes carrying it out per pixel;
+        ``blocks``: the meter pass's (:meth:`_meter_blocks`)."""
         sensor = development.sensor
-        blocks = self._meter_blocks()
         metered = float((blocks[..., 2] * blocks[..., 3]).sum() / max(float(blocks[..., 3].sum()), 1.0))
         time, gain = sensor.exposure_for(metered)
         shift, zoom, samples = 0.0, 0.0, 1

@@ -1,8 +1,8 @@
 // Exposure metering: each output texel averages, over a block of pixels, the log luminance (HDR
 // alpha) sampling every second pixel in each direction (the renderer's own auto-exposure), and the
 // linear luminance of every pixel (what a sensor model meters). Non-finite values are left out of
-// both (a shader fault must not decide the exposure of the whole frame; the tone map and the
-// sensor flag those pixels).
+// both (a shader fault must not decide the exposure of the whole frame), and the count of finite
+// pixels tells the renderer to refuse a frame that has any.
 uniform sampler2D u_hdr;
 uniform int u_block;
 out vec4 out_meter;          // mean log luminance, its samples, mean linear luminance, its samples
