@@ -58,6 +58,7 @@ GROUND_TRUTH = "/ravh/ground_truth"                # std_msgs/String JSON footpr
 TF = "/tf"                                         # tf2_msgs/TFMessage: odom -> base_link, map -> odom (see map_tf)
 TF_STATIC = "/tf_static"                           # tf2_msgs/TFMessage, latched: every agent's sensor mounts
 TF_STATIC_TOPIC = "tf_static/{child}"              # geometry_msgs/TransformStamped, latched: one mount each
+DIAGNOSTICS = "/diagnostics"                       # diagnostic_msgs/DiagnosticArray: the sim's health, 1 Hz
 
 # ---------------------------------------------------------------- services
 # JSON services use diagnostic_msgs/srv/AddDiagnostics, the one standard service shaped

@@ -11,6 +11,7 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 import rclpy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph import start_rclpy
@@ -21,6 +22,7 @@ from std_srvs.srv import Trigger
 from ravh_msgs_py import names as n
 from ravh_msgs_py.capture import CaptureEvent
 from ravh_sim.nodes import convert
+from ravh_sim.render.gl_renderer import RenderError
 from ravh_sim.render.views import RenderedViews
 from ravh_sim.sensors import imaging
 
@@ -37,6 +39,7 @@ class StandInRenderer:
         self.began: list[float] = []
         self.ended: list[float] = []
         self.slow: Callable[[float], bool] = lambda began: True
+        self.fail: Callable[[], bool] = lambda: False      # True: this render raises (a refused frame)
 
     def render(self, position, rotation, exposure=None, radiance=False, development=None) -> RenderedViews:
         began = self.node.runtime.time
@@ -45,6 +48,8 @@ class StandInRenderer:
         while not self.slow(began) and time.monotonic() < give_up:
             time.sleep(0.002)
         self.ended.append(self.node.runtime.time)
+        if self.fail():
+            raise RenderError("3 pixels of non-finite radiance (instances [7]): the stand-in's bad frame")
         h, w = self.shape
         return RenderedViews(np.full((h, w, 3), 128, np.uint8), np.full((h, w), 2.0, np.float32),
                              np.ones((h, w), np.uint16), np.zeros((h, w), bool))
@@ -56,10 +61,10 @@ class StandInRenderer:
 class Session:
     """A sim node (house 20, real time) with a stand-in renderer, and a test node beside it."""
 
-    def __init__(self, policy: str) -> None:
+    def __init__(self, policy: str, **parameters) -> None:
         from ravh_sim.nodes.sim_node import SimNode
         start_rclpy()
-        self.sim = SimNode({"house": 20, "seed": 0, "renderer": "tiny", "frame_policy": policy})
+        self.sim = SimNode({"house": 20, "seed": 0, "renderer": "tiny", "frame_policy": policy, **parameters})
         self.agent = self.sim.runtime.agents[0]
         camera = self.agent.sensors["camera"]
         camera.renderer = self.renderer = StandInRenderer(self.sim, camera.width, camera.height)
@@ -89,11 +94,15 @@ class Session:
             self.executor.spin_once(timeout_sec=0.01)
 
     def capture(self) -> Trigger.Response:
+        return self.captures(1)[0]
+
+    def captures(self, count: int) -> list[Trigger.Response]:
+        """``count`` capture requests sent at once, before the node has taken any; their replies."""
         client = self.node.create_client(Trigger, n.CAPTURE_SERVICE)
         assert client.wait_for_service(timeout_sec=30)
-        future = client.call_async(Trigger.Request())
-        self.spin_until(future.done)
-        return future.result()
+        futures = [client.call_async(Trigger.Request()) for _ in range(count)]
+        self.spin_until(lambda: all(f.done() for f in futures))
+        return [f.result() for f in futures]
 
     def close(self) -> None:
         self.renderer.slow = lambda began: True     # a frame still rendering would wait for sim time that
@@ -183,5 +192,57 @@ class TestWaitingForFrames:
             images = s.listen(Image, n.COLOR_IMAGE)
             s.spin_until(lambda: len(images) >= 6)
             assert np.allclose(np.diff(stamps(images)[1:]), PERIOD, atol=1e-3)    # the first: the first step
+        finally:
+            s.close()
+
+
+def diagnostics(msg: DiagnosticArray) -> tuple[int, dict[str, str]]:
+    """The sim's status in a /diagnostics message: its level and its values."""
+    (status,) = [s for s in msg.status if s.name == "ravh_sim: sim"]
+    return status.level, {v.key: v.value for v in status.values}
+
+
+class TestBadFrames:
+    def test_a_frame_that_fails_is_dropped_counted_and_the_stream_goes_on(self, session):
+        images, health = session.listen(Image, n.COLOR_IMAGE), session.listen(DiagnosticArray, n.DIAGNOSTICS)
+        session.spin_until(lambda: len(images) >= 2)
+        bad, published = len(session.renderer.began), len(images)   # the next render raises, later ones not
+        session.renderer.fail = lambda: len(session.renderer.began) == bad + 1
+        session.spin_until(lambda: len(images) >= published + 3)     # the stream goes on after it
+        assert len(session.renderer.ended) >= bad + 1 and session.sim.health.failed == 1
+        assert session.sim.health.published >= published + 3
+        session.spin_until(lambda: health and diagnostics(health[-1])[1]["frames_failed"] == "1", 30)
+        level, values = diagnostics(health[-1])
+        assert level == DiagnosticStatus.WARN and "non-finite radiance" in values["last_failure"]
+        assert int(values["frames_dropped"]) >= 1 and float(values["render_ms"]) >= 0
+        session.renderer.fail = lambda: False
+
+    def test_a_capture_whose_frame_fails_replies_with_the_reason(self, session):
+        session.renderer.fail = lambda: True
+        try:
+            reply = session.capture()
+        finally:
+            session.renderer.fail = lambda: False
+        assert not reply.success and "non-finite radiance" in reply.message
+        reply = session.capture()                                  # the node is alive and captures again
+        assert reply.success, reply.message
+
+
+class TestCaptureIdentity:
+    def test_captures_while_sim_time_stands_still_get_stamps_of_their_own(self):
+        """Lockstep with nothing granted: sim time stands still. Four captures requested at once are four
+        captures, each with its own stamp, each frame published at its stamp (they would share one)."""
+        s = Session("drop", lockstep=True)
+        try:
+            images = s.listen(Image, n.COLOR_IMAGE)
+            still = s.sim.runtime.time
+            replies = s.captures(4)
+            assert all(r.success for r in replies), [r.message for r in replies]
+            events = [CaptureEvent.from_json(r.message) for r in replies]
+            captured = sorted(e.stamp for e in events)
+            assert len(set(captured)) == 4 and captured[0] >= still
+            assert np.diff(captured).min() > 0
+            s.spin_until(lambda: all(np.isclose(stamps(images), t, rtol=0, atol=1e-9).any() for t in captured))
+            assert s.sim.runtime.time <= captured[-1] + 1e-9         # the sim took only the steps it needed
         finally:
             s.close()

@@ -29,6 +29,7 @@ import argparse
 import json
 import struct
 import time
+from collections import deque
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -125,7 +126,11 @@ class _Pending:
 
 
 class StampMatcher:
-    """Gathers a capture's parts by stamp; hands the set over once every required part is in."""
+    """Gathers a capture's parts by stamp; hands the set over once every required part is in.
+
+    The sim gives every capture of an agent a stamp of its own (ravh_sim.nodes.sim_node), so a stamp
+    names one capture. A second event at a stamp that already has one (pending or stored) would merge
+    two captures: it is refused and reported in :attr:`duplicates`, never matched."""
 
     def __init__(self, required: set[str], max_pending: int = MAX_PENDING,
                  timeout_s: float = PENDING_TIMEOUT_S) -> None:
@@ -133,13 +138,20 @@ class StampMatcher:
         self.max_pending, self.timeout_s = max_pending, timeout_s
         self.pending: dict[int, _Pending] = {}
         self.lost: list[int] = []                     # stamps of captures (with an event) given up on
+        self.duplicates: list[int] = []               # stamps of events refused: a capture had that stamp
+        self._matched: deque[int] = deque(maxlen=4 * max_pending)     # stamps of recent complete sets
 
     def add(self, stamp_ns: int, part: str, value: Any, now: float) -> dict[str, Any] | None:
         """Add one part (the first of a stamp wins); returns the complete set, else None."""
+        taken = stamp_ns in self._matched or (stamp_ns in self.pending and "event" in self.pending[stamp_ns].parts)
+        if part == "event" and taken:
+            self.duplicates.append(stamp_ns)
+            return None
         entry = self.pending.setdefault(stamp_ns, _Pending(now))
         entry.parts.setdefault(part, value)
         if self.required <= entry.parts.keys():
             del self.pending[stamp_ns]
+            self._matched.append(stamp_ns)
             return entry.parts
         self._prune(now)
         return None
@@ -155,6 +167,10 @@ class StampMatcher:
     def _drop(self, stamp: int) -> None:
         if "event" in self.pending.pop(stamp).parts:
             self.lost.append(stamp)
+
+    def waiting(self) -> int:
+        """Announced captures (their event is in) still waiting for parts."""
+        return sum("event" in e.parts for e in self.pending.values())
 
 
 # ---------------------------------------------------------------------------- the bag
@@ -299,6 +315,10 @@ class RecorderNode(Node):
         while self.matcher.lost:
             self.lost += 1
             self.log.error(f"capture at t={self.matcher.lost.pop(0) / NS:.3f} s incomplete: lost")
+        while self.matcher.duplicates:
+            self.lost += 1
+            self.log.error(f"a second capture at t={self.matcher.duplicates.pop(0) / NS:.3f} s: two captures "
+                           "cannot share a stamp; the later one is lost")
         if parts is not None:
             self._complete(parts)
 
@@ -342,9 +362,14 @@ class RecorderNode(Node):
             raise UserError(f"dataset write failed ({self.failure}); stopped with {self.captures} captures "
                             f"in {self.out}")
 
+    def in_flight(self) -> bool:
+        """Whether an announced capture still waits for parts: a stopping recorder spins on until it is
+        complete (spin_until_stopped, bounded), so Ctrl-C loses none it was told of."""
+        return self.matcher.waiting() > 0
+
     def close(self) -> None:
         """Finish queued writes, then close the dataset and the bag (SIGINT lands here)."""
-        waiting = sum("event" in e.parts for e in self.matcher.pending.values())
+        waiting = self.matcher.waiting()
         self.worker.shutdown(wait=True)
         self.writer.close()
         if self.bag:

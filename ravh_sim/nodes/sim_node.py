@@ -24,7 +24,16 @@ is stamped with the sim time of its pose.
 slam_toolbox expect of a clock that follows the wall clock (logged once); ``wait`` keeps every frame
 by holding sim time until the last frame is out (the camera's rate in sim time, a slower sim).
 Requests never take it down: bad commands are refused with a throttled warning, bad service
-requests get an error reply.
+requests get an error reply. Nor do frames: a frame the renderer refuses (non-finite radiance) or fails
+is one dropped frame, logged once per cause and counted on ``/diagnostics`` (the node's health, see
+ravh_sim.nodes.health); a capture whose frame fails replies ``success: false`` with the reason.
+
+A capture is known by its stamp, and no two captures of an agent share one: a capture requested while
+sim time still stands at the previous capture's stamp (a paused or lockstep sim, a loaded machine, two
+requests back to back at ``--rtf 0``) waits for the next physics step (in lockstep the sim grants itself
+that one step). So every message of a capture (image, depth, instances, camera_infos, scan, the event)
+carries one stamp that names that capture alone, which is what rosbag2, message_filters' exact-time
+synchroniser and our recorder match on; a ROS header has no sequence number to carry instead.
 """
 from __future__ import annotations
 
@@ -39,6 +48,7 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from functools import partial
 from typing import Any
 
+from diagnostic_msgs.msg import DiagnosticArray
 from diagnostic_msgs.srv import AddDiagnostics
 from geometry_msgs.msg import PoseStamped, TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import OccupancyGrid, Odometry
@@ -47,7 +57,7 @@ from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_system_default
 from rclpy.task import Future as RosFuture
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import String
@@ -71,6 +81,7 @@ from ravh_sim.nodes.common import (
     return_freed_memory,
     run_node,
 )
+from ravh_sim.nodes.health import SimHealth
 from ravh_sim.render.backend import BACKENDS
 from ravh_sim.runtime import ODOM, Agent, Schedule, SimRuntime
 from ravh_sim.sensors.ports import SensorPort, Topic
@@ -104,6 +115,7 @@ HEARTBEAT_S = 0.5                       # lockstep: wall period of /clock and po
 CHANGE_SHARE = 0.15
 CHANGE_BURST_S = 1.0
 CHANGES_PER_BATCH = 1
+DIAGNOSTICS_PERIOD_S = 1.0              # wall seconds between /diagnostics messages (the ROS habit: 1 Hz)
 
 
 class SimNode(Node):
@@ -136,6 +148,9 @@ class SimNode(Node):
         self._frames: dict[str, Future] = {}          # agent -> its camera frame being rendered
         self._dropping = False
         self._captures_rendering = 0
+        self._captures_waiting = 0                    # for a step past the agent's last capture stamp
+        self._capture_stamps: dict[str, float] = {}   # agent -> its last capture's stamp
+        self._step_waiters: list[RosFuture] = []      # done at the next physics step
         rt = self.runtime
         self.get_logger().info(
             f"house {rt.house.number}: {len(rt.house.rooms)} rooms, {len(rt.house.objects)} objects, "
@@ -160,8 +175,11 @@ class SimNode(Node):
         self._publishing_map_tf = {agent.name: self.map_tf != "off" for agent in rt.agents}
         if self.map_tf == "auto":
             self.create_subscription(TFMessage, n.TF, self._on_tf, TF_LISTEN_QOS)
+        self.health = SimHealth(self.rtf, self.get_logger().warning)
+        self.diagnostics_pub = self.create_publisher(DiagnosticArray, n.DIAGNOSTICS, qos_profile_system_default)
         self._publish_latched()
         self.timer = self.create_timer(TICK_S, self._tick)
+        self.create_timer(DIAGNOSTICS_PERIOD_S, self._publish_diagnostics)
 
     def _on_render_thread(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
         """``fn(*args, **kwargs)`` run on the render thread (after the frames queued before it); its result."""
@@ -261,11 +279,16 @@ class SimNode(Node):
             last = min(last, rt.step_at(self._sim0 + self.rtf * (time.monotonic() - self._wall0)))
         if self.lockstep:
             last = min(last, self._allowed)
-        deadline = time.monotonic() + MAX_STEP_S
+        deadline, first = time.monotonic() + MAX_STEP_S, rt.steps
         while rt.steps < last and time.monotonic() < deadline:
             self._watchdog()
             rt.step()
             self._publish_due()
+        self.health.sim_time(rt.time)
+        if rt.steps > first:
+            waiters, self._step_waiters = self._step_waiters, []
+            for step in waiters:
+                step.set_result(None)
         if self.lockstep and rt.steps >= self._allowed and time.monotonic() - self._heartbeat > HEARTBEAT_S:
             self._arrived()
         if self.rtf > 0 and rt.time + MAX_STEP_S < self._sim0 + self.rtf * (time.monotonic() - self._wall0):
@@ -399,6 +422,7 @@ class SimNode(Node):
         busy = self._frames.get(agent.name)
         if busy is not None and not busy.done() and self.frame_policy == "drop":
             rt.skip(agent, port.name)
+            self.health.frame_skipped()
             if not self._dropping:
                 self._dropping = True
                 self.get_logger().warning(
@@ -407,17 +431,33 @@ class SimNode(Node):
                     "frame by slowing the sim)")
             return
         if busy is not None:
-            busy.result()                 # wait: sim time holds until the frame is out; raises its error
+            busy.result()                 # wait: sim time holds until the frame is out
         self._frames[agent.name] = self.render_thread.submit(
-            self._render_frame, agent, port, rt.frame_later(agent), self._now(), topics)
+            self._stream_frame, agent, port, rt.frame_later(agent), self._now(), topics)
+
+    def _stream_frame(self, agent: Agent, port: SensorPort, frame: Callable[[], Any], stamp: float,
+                      topics: tuple[Topic, ...]) -> None:
+        """On the render thread: a streamed frame; one that fails is dropped (counted, its cause logged
+        once) and the stream goes on with the next."""
+        try:
+            self._render_frame(agent, port, frame, stamp, topics)
+        except Exception:  # never die from a frame: _render_frame counted it
+            pass
 
     def _render_frame(self, agent: Agent, port: SensorPort, frame: Callable[[], Any], stamp: float,
                       topics: tuple[Topic, ...]) -> None:
         """On the render thread: render ``frame`` and publish it on ``topics``, stamped ``stamp`` (when it
-        was asked for: the sim time of its pose)."""
+        was asked for: the sim time of its pose). A frame that fails is counted on /diagnostics and raised."""
         start = time.monotonic()
-        self._publish_sensor(agent, port, frame(), stamp, topics)
-        self._note_reading((agent.name, port.name), time.monotonic() - start)
+        try:
+            data = frame()
+        except Exception as e:
+            self.health.frame_failed(f"{agent.name}'s {port.name} frame at t={stamp:.3f} s", e)
+            raise
+        self._publish_sensor(agent, port, data, stamp, topics)
+        seconds = time.monotonic() - start
+        self.health.frame_rendered(seconds)
+        self._note_reading((agent.name, port.name), seconds)
 
     def _publish_sensor(self, agent: Agent, port: SensorPort, data: Any, stamp: float,
                         topics: tuple[Topic, ...]) -> None:
@@ -444,7 +484,7 @@ class SimNode(Node):
         not: physics and /clock go on meanwhile. At real-time factor 0 (as fast as possible) the tick
         does wait: there is no rate to keep, and a sim racing on would push the capture's readings out
         of its readers' queues before they took them."""
-        rt, stamp = self.runtime, self._now()
+        rt, stamp = self.runtime, await self._capture_stamp(agent)
         event = rt.capture_event(agent)
         rendered = []
         self._captures_rendering += 1
@@ -461,6 +501,27 @@ class SimNode(Node):
             self._captures_rendering -= 1
         self.agent_pubs[agent.name]["capture"].publish(String(data=event.to_json()))
         return event
+
+    async def _capture_stamp(self, agent: Agent) -> float:
+        """Sim time now, once it is past ``agent``'s last capture stamp (waiting for the next physics step
+        if need be; in lockstep the sim grants itself that step): every capture has a stamp of its own."""
+        rt = self.runtime
+        self._captures_waiting += 1
+        try:
+            while rt.time <= self._capture_stamps.get(agent.name, -math.inf):
+                if self.lockstep:
+                    self._allowed = max(self._allowed, rt.steps + 1)
+                step = RosFuture()
+                self._step_waiters.append(step)
+                await step
+        finally:
+            self._captures_waiting -= 1
+        stamp = self._capture_stamps[agent.name] = self._now()
+        return stamp
+
+    def _publish_diagnostics(self) -> None:
+        self.diagnostics_pub.publish(self.health.array(self.runtime.time,
+                                                       self._captures_waiting + self._captures_rendering))
 
     # ------------------------------------------------------------------ map -> odom ownership
     def _on_tf(self, msg: TFMessage) -> None:
@@ -565,8 +626,9 @@ class SimNode(Node):
         return response
 
     def in_flight(self) -> bool:
-        """Whether a requested capture is still waiting for its frame (spin_until_stopped finishes it)."""
-        return self._captures_rendering > 0
+        """Whether a requested capture is still waiting for its stamp or its frame (spin_until_stopped
+        finishes it)."""
+        return self._captures_rendering + self._captures_waiting > 0
 
     def close(self) -> None:
         self._on_render_thread(self.runtime.close)

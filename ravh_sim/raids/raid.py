@@ -142,7 +142,7 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
                           HANDOVER_GRACE_S)
             _stop(recorder)
             _stop(sim)
-        rows, requested = _rows(captures), len(_rows(given))
+        rows, requested = _stored(out), len(_rows(given))
         status = _final_status(status, requested, len(rows), behaviour, recorder)
         summary = {**raid_meta, "status": status, "captures": len(rows), "requested": requested,
                    "rooms_visited": sorted({r["room"] for r in rows if r.get("room")}),
@@ -210,6 +210,12 @@ def _stop(proc: subprocess.Popen | None, timeout: float = 30.0) -> None:
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.wait()
+
+
+def _stored(out: Path) -> list[dict]:
+    """The rows of the dataset whose files are all on disk: what raid.json counts as recorded."""
+    return [row for row in _rows(out / layout.CAPTURES_JSONL)
+            if all((out / rel).is_file() for rel in row.get("files", {}).values())]
 
 
 def _rows(path: Path) -> list[dict]:
