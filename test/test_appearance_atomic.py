@@ -149,3 +149,40 @@ def test_200_seeds_of_randomise_all_succeed(houses):
     finally:
         for world in worlds.values():
             world.close()
+
+
+def test_a_rollback_that_fails_is_an_error_reply_and_an_error_log(caplog, monkeypatch):
+    """Issue 31: should putting a half-applied change back fail too (the disk is still full), the world is
+    neither as it was nor as asked. The reply says so and names what could not be put back, the log
+    has it as an error, and everything else is still put back."""
+    rt = SimRuntime(15, renderer="tiny")
+    try:
+        world = rt.world
+        before = world.state.settings()
+        load_model, calls = world.load_model, []
+
+        def failing(object_id: str, model: int) -> None:
+            calls.append(object_id)
+            if len(calls) > 1:                  # the second swap fails, and so does putting the first back
+                raise OSError(28, "No space left on device")
+            load_model(object_id, model)
+
+        monkeypatch.setattr(world, "load_model", failing)
+        with caplog.at_level("ERROR", logger="ravh_sim.world.appearance"):
+            reply = rt.change_appearance({"sun_angle": "night", "paint": {"all": {"walls": "rose"}},
+                                          "models": {"Bed_0": 1, "Counter_0": 2, "Sink_0": 1}})
+        monkeypatch.undo()
+        stuck = calls[0]
+        assert len(calls) == 3 and calls[2] == stuck          # swapped, failed, then failed to put back
+        assert not reply["ok"] and reply["error"]["code"] == "internal"
+        message = reply["error"]["message"]
+        assert message.startswith("RollbackError:") and "No space left on device" in message
+        assert f"not put back: model of {stuck} (index {before.models[stuck]})" in message
+        assert message.count("model of") == 1                  # only the item that could not be put back
+        errors = [r for r in caplog.records if r.levelname == "ERROR"]
+        assert len(errors) == 1 and f"model of {stuck}" in errors[0].getMessage()
+        now = world.state.settings()
+        assert now.models[stuck] != before.models[stuck]                     # the state says what is shown
+        assert now.changed(models=before.models) == before                   # all else was put back
+    finally:
+        rt.close()

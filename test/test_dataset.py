@@ -166,15 +166,46 @@ def test_a_crash_between_files_leaves_no_half_capture(tmp_path, footprint20, mon
     assert len(ds) == 1 and ds[0].stamp == 1.0 and ds[0].rgb.shape == (H, W, 3)
 
 
-def test_torn_lines_and_missing_files_are_skipped(tmp_path, footprint20):
+def test_torn_lines_and_missing_files_are_skipped(tmp_path, footprint20, caplog):
+    """What a killed recorder or a power cut leaves is left out, and said (issue 31: not silently)."""
     room = sorted(rooms_of(footprint20))[0]
     root = tmp_path / "b"
     write_dataset(root, footprint20, [(room, (0.0, 0.0, 0.0))] * 2)
     with open(root / layout.CAPTURES_JSONL, "a") as f:         # killed while appending a line
         f.write('{"index": 2, "stamp": 12.0, "agent": "rob')
     (root / "rgb/000000.png").unlink()                         # a file lost in a power cut
-    ds = Dataset(root)
+    with caplog.at_level("WARNING", logger="ravh_sim.dataset.api"):
+        ds = Dataset(root)
     assert [s.index for s in ds] == [1]
+    said = [r.getMessage() for r in caplog.records if r.name == "ravh_sim.dataset.api" and r.levelname == "WARNING"]
+    assert len(said) == 2, said
+    assert said[0].startswith(f"{root / layout.CAPTURES_JSONL}:3: torn last line left out")
+    assert said[1] == f"{root / layout.CAPTURES_JSONL}: 1 capture(s) left out whose files are missing (line 1)"
+
+
+def test_a_complete_dataset_reads_without_a_warning(tmp_path, footprint20, caplog):
+    room = sorted(rooms_of(footprint20))[0]
+    write_dataset(tmp_path / "fine", footprint20, [(room, (0.0, 0.0, 0.0))] * 2)
+    with caplog.at_level("DEBUG", logger="ravh_sim.dataset.api"):
+        assert len(Dataset(tmp_path / "fine")) == 2
+    assert [r for r in caplog.records if r.name == "ravh_sim.dataset.api"] == []
+
+
+@pytest.mark.parametrize("bad", ['{"index": 1, "stamp": 11.0, "agent": "rob\n',     # a torn line, then more
+                                 "\n", "[1, 2]\n", '{"index": 1}\n'])
+def test_a_malformed_line_in_the_middle_refuses_the_dataset_naming_file_and_line(tmp_path, footprint20, bad):
+    """A torn line is tolerated only last (the recorder died writing it); anywhere else captures.jsonl is
+    damaged and reading on would hide it: one line names the file and the line."""
+    room = sorted(rooms_of(footprint20))[0]
+    root = tmp_path / "c"
+    write_dataset(root, footprint20, [(room, (0.0, 0.0, 0.0))] * 3)
+    path = root / layout.CAPTURES_JSONL
+    lines = path.read_text().splitlines(keepends=True)
+    path.write_text(lines[0] + bad + lines[2])                   # line 2 damaged, lines 1 and 3 fine
+    with pytest.raises(UserError) as refused:
+        Dataset(root)
+    message = str(refused.value)
+    assert message.startswith(f"{path}:2: malformed capture row") and "\n" not in message
 
 
 def test_a_full_disk_stops_a_capture_without_a_torn_file(tmp_path, footprint20):
@@ -317,6 +348,18 @@ def test_matcher_waits_for_every_part_in_any_order():
     assert m.lost == [9] and 9 not in m.pending
 
 
+def test_matcher_refuses_a_second_capture_at_one_stamp():
+    """Two events at one stamp would merge two captures: the second is refused and reported, pending or
+    after the first was stored."""
+    m = recorder_module().StampMatcher({"rgb", "event"})
+    assert m.add(5, "event", "e5", 0.0) is None
+    assert m.add(5, "event", "another e5", 0.0) is None and m.duplicates == [5]
+    assert m.add(5, "rgb", "r5", 0.0) == {"event": "e5", "rgb": "r5"}
+    assert m.add(5, "event", "a third e5", 0.1) is None and m.duplicates == [5, 5] and m.pending == {}
+    assert m.add(6, "rgb", "r6", 0.1) is None and m.add(6, "event", "e6", 0.1) == {"rgb": "r6", "event": "e6"}
+    assert m.waiting() == 0 and m.add(7, "event", "e7", 0.2) is None and m.waiting() == 1
+
+
 def test_stamps_from_cdr_and_events_agree():
     rec = recorder_module()
     from rclpy.serialization import serialize_message
@@ -357,13 +400,17 @@ def start_recorder(sim, out: Path, *args: str) -> NodeProcess:
 
 
 def request_capture(sim) -> CaptureEvent:
-    import rclpy
+    return request_captures(sim, 1)[0]
+
+
+def request_captures(sim, count: int) -> list[CaptureEvent]:
+    """``count`` capture requests sent at once (the sim takes them before its clock moves); their events."""
     from std_srvs.srv import Trigger
     _, node, client = sim
-    future = client.call_async(Trigger.Request())
-    rclpy.spin_until_future_complete(node, future, timeout_sec=20)
-    assert future.done() and future.result().success
-    return CaptureEvent.from_json(future.result().message)
+    futures = [client.call_async(Trigger.Request()) for _ in range(count)]
+    assert spin_until(node, lambda: all(f.done() for f in futures), 20 * count)
+    assert all(f.result().success for f in futures), [f.result().message for f in futures]
+    return [CaptureEvent.from_json(f.result().message) for f in futures]
 
 
 def rows(out: Path) -> int:
@@ -418,6 +465,22 @@ def test_recorder_writes_captures_and_a_bag(sim, tmp_path):
     valid = np.isfinite(depth)
     assert np.array_equal(valid, np.isfinite(ds[0].depth))
     assert np.abs(depth[valid] - ds[0].depth[valid]).max() <= 0.0005 + 1e-6
+
+
+def test_captures_requested_at_once_all_land_distinct(sim, tmp_path):
+    """Requests that reach the sim together, before its clock moves (as under load or from several
+    clients): each capture gets a stamp of its own, and the dataset holds each once, whole."""
+    out = tmp_path / "burst"
+    with start_recorder(sim, out) as rec:
+        events = request_captures(sim, 4) + request_captures(sim, 3)
+        assert len({e.stamp for e in events}) == 7
+        assert spin_until(sim[1], lambda: rows(out) == 7, 60), rec.log()[-3000:]
+        assert rec.stop() == 0, rec.log()[-3000:]
+    ds = Dataset(out)
+    assert [s.stamp for s in ds] == sorted(e.stamp for e in events)
+    by_stamp = {e.stamp: e for e in events}
+    for sample in ds:
+        assert sample.pose == pytest.approx(by_stamp[sample.stamp].pose) and len(sample.scan.ranges) == 360
 
 
 def test_a_killed_recorder_leaves_a_consistent_dataset(sim, tmp_path):

@@ -5,11 +5,15 @@ objects or rooms of a kind the house has, which rooms the robot visited. Counts 
 footprint stored with the dataset, so they describe exactly the world that was recorded. Pixels are
 read lazily, one sample at a time, and decoded by the sensor ports that stored them. A dataset cut
 short (recorder killed) reads as the captures that were complete: a torn last line of
-captures.jsonl, or a line whose files are missing, is skipped.
+captures.jsonl (no newline: the writer died appending it) is left out with a warning, and so are
+lines whose files are missing (this module's ``logging`` logger). A malformed line anywhere else is
+no crash to tolerate but a damaged file: it is refused (:class:`~ravh_sim.errors.UserError` naming
+the file and the line).
 """
 from __future__ import annotations
 
 import json
+import logging
 from collections import Counter
 from collections.abc import Iterator
 from functools import cached_property
@@ -29,6 +33,7 @@ from ravh_sim.sensors.suite import SENSORS
 from ravh_sim.world.house import House, load_house
 from ravh_sim.world.settings import Resolved
 
+log = logging.getLogger(__name__)
 MIN_PIXELS = 50          # an instance with fewer pixels in an image does not count as visible there
 
 
@@ -174,20 +179,39 @@ def _read_json(path: Path) -> Any:
 
 
 def _complete_rows(root: Path) -> list[dict[str, Any]]:
-    """The rows of captures.jsonl that end in a newline, parse, and whose files all exist."""
+    """The rows of captures.jsonl whose files all exist. A torn last line (no newline: the writer was
+    killed while appending it) and rows whose files are missing are left out with a warning; a line
+    that does not parse as a capture row anywhere else refuses the dataset (UserError, file:line)."""
     path = root / layout.CAPTURES_JSONL
     text = path.read_text(encoding="utf-8") if path.exists() else ""
-    rows = []
-    for line in text.splitlines(keepends=True):
-        if not line.endswith("\n"):
-            break                                   # torn last line: the writer died while appending
-        try:
-            row = json.loads(line)
-        except ValueError:
-            continue
+    *lines, torn = text.split("\n")                 # every line but a torn last one ends in a newline
+    rows: list[dict[str, Any]] = []
+    missing: list[int] = []
+    for number, line in enumerate(lines, start=1):
+        row = _row(path, number, line)
         if all((root / rel).is_file() for rel in row["files"].values()):
             rows.append(row)
+        else:
+            missing.append(number)
+    if torn:
+        log.warning("%s:%d: torn last line left out (the recorder was killed while writing it): %.60r",
+                    path, len(lines) + 1, torn)
+    if missing:
+        log.warning("%s: %d capture(s) left out whose files are missing (line %s)", path, len(missing),
+                    ", ".join(map(str, missing[:10])) + (" ..." if len(missing) > 10 else ""))
     return rows
+
+
+def _row(path: Path, number: int, line: str) -> dict[str, Any]:
+    """Line ``number`` of captures.jsonl as a capture row; UserError naming the file and line if it is not one."""
+    try:
+        row = json.loads(line)
+    except ValueError as e:
+        raise UserError(f"{path}:{number}: malformed capture row ({e}); the dataset is damaged") from None
+    if not isinstance(row, dict) or not isinstance(row.get("files"), dict):
+        raise UserError(f"{path}:{number}: malformed capture row (not an object with 'files'); "
+                        "the dataset is damaged")
+    return row
 
 
 def _palette(instances: dict[int, dict[str, Any]]) -> np.ndarray:

@@ -2,14 +2,16 @@
 
 ``gl``: ravh_sim's OpenGL renderer on a headless EGL context (moderngl; Mesa llvmpipe on a CPU, a
 GPU where there is one). ``tiny``: pybullet's TinyRenderer, the slow fallback when no GL context can
-be made (and the benchmark baseline). ``auto`` picks ``gl`` when it starts, else ``tiny`` with a
-one-line warning. One EGL context serves the whole process (a second one, or pybullet's EGL plugin
-beside it, has crashed Mesa here).
+be made (and the benchmark baseline). ``auto`` picks ``gl`` when it starts, else ``tiny``, with a
+warning (once, this module's ``logging`` logger) naming the exception that stopped OpenGL;
+:func:`choose_backend` also returns it. One EGL context serves the whole process (a second one, or
+pybullet's EGL plugin beside it, has crashed Mesa here).
 """
 from __future__ import annotations
 
 import ctypes
-import sys
+import logging
+import threading
 from collections.abc import Callable
 from ctypes.util import find_library
 from dataclasses import dataclass
@@ -23,31 +25,76 @@ BACKENDS = ("auto", "gl", "tiny")
 QUALITIES = ("realistic", "fast")
 
 
-def resolve_backend(requested: str) -> str:
-    """'gl' or 'tiny' for a requested backend name (ValueError for an unknown one)."""
+@dataclass(frozen=True)
+class BackendChoice:
+    """The backend a requested name resolves to, and why it is not the one asked for (``auto``
+    falling back to ``tiny``: the exception that stopped OpenGL, ``"OSError: ..."``), else None."""
+    backend: str                       # gl | tiny
+    fallback_reason: str | None = None
+
+
+def choose_backend(requested: str) -> BackendChoice:
+    """The backend for a requested name, with the reason of a fallback (ValueError for an unknown name;
+    RuntimeError, naming why, for ``gl`` when OpenGL cannot start). The first fallback of the process
+    is logged as a warning naming the exception."""
+    global _fallback_logged
     if requested not in BACKENDS:
         raise ValueError(f"renderer must be one of {BACKENDS}, got {requested!r}")
     if requested == "tiny":
-        return "tiny"
-    if gl_context() is None:
+        return BackendChoice("tiny")
+    start = gl_start()
+    if start.context is None:
         if requested == "gl":
-            raise RuntimeError("the gl renderer needs an EGL OpenGL 4.3 context, which could not be made")
-        print("ravh_sim: OpenGL (EGL) unavailable, falling back to TinyRenderer (slower)", file=sys.stderr)
-        return "tiny"
-    return "gl"
+            raise RuntimeError(f"the gl renderer needs an EGL OpenGL 4.3 context, which could not be made: "
+                               f"{start.failure}")
+        if not _fallback_logged:
+            _fallback_logged = True
+            log.warning("ravh_sim: OpenGL (EGL) could not start (%s); falling back to TinyRenderer (slower, "
+                        "and its images differ)", start.failure)
+        return BackendChoice("tiny", start.failure)
+    return BackendChoice("gl")
 
 
-@lru_cache(maxsize=1)
+def resolve_backend(requested: str) -> str:
+    """'gl' or 'tiny' for a requested backend name (see :func:`choose_backend`, which also says why)."""
+    return choose_backend(requested).backend
+
+
+@dataclass(frozen=True)
+class GLStart:
+    """The outcome of starting the process's OpenGL context: the context, or why there is none."""
+    context: moderngl.Context | None
+    failure: str | None = None         # "ExceptionType: message" of what stopped it
+
+
+def gl_start() -> GLStart:
+    """Start the process's moderngl context (EGL, headless) once; later calls return the same outcome."""
+    global _gl
+    with _gl_lock:
+        if _gl is None:
+            try:
+                _gl = GLStart(_create_context())
+            except Exception as e:         # no libEGL, no driver, GL too old: all mean "no GL"
+                _gl = GLStart(None, f"{type(e).__name__}: {e}")
+        return _gl
+
+
 def gl_context() -> moderngl.Context | None:
-    """The process's moderngl context (EGL, headless), or None when none can be made."""
-    try:
-        import moderngl
-        # the ignore: moderngl's stub types every **settings value as a dict, but backend is a str
-        ctx = moderngl.create_context(standalone=True, backend="egl", require=430)  # type: ignore[arg-type]
-    except Exception:                      # no libEGL, no driver, GL too old: all mean "no GL"
-        return None
-    return ctx
+    """The process's moderngl context (EGL, headless), or None when none can be made (why:
+    :func:`gl_start`)."""
+    return gl_start().context
 
+
+def _create_context() -> moderngl.Context:
+    import moderngl
+    # the ignore: moderngl's stub types every **settings value as a dict, but backend is a str
+    return moderngl.create_context(standalone=True, backend="egl", require=430)  # type: ignore[arg-type]
+
+
+log = logging.getLogger(__name__)
+_gl: GLStart | None = None             # one EGL context serves the whole process (see the module's doc)
+_gl_lock = threading.Lock()
+_fallback_logged = False
 
 
 GL_TRIANGLES = 0x0004

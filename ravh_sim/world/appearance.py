@@ -12,13 +12,17 @@ switching them costs nothing. Random choices go through
 The sun model (:func:`sun_light`) is here too: one angle gives the light direction, the colour and
 level of daylight indoors and the sky colour seen beyond the house and through the windows; and the
 lamp model (:func:`lamps_at`): the lights' colours at a colour temperature.
+
+A change that fails half-way is put back (:meth:`Appearance.apply`); should putting back fail too,
+the world is neither as it was nor as asked, and that is never silent: :class:`RollbackError` names
+what could not be put back, and it is logged as an error (this module's ``logging`` logger).
 """
 from __future__ import annotations
 
-import contextlib
 import copy
+import logging
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Any
@@ -33,6 +37,7 @@ from ravh_sim.world.settings import Resolved, fit_model, knob_value, light_group
 from ravh_sim.world.solids import model_count
 
 RGB = tuple[float, float, float]
+log = logging.getLogger(__name__)
 
 # Daylight indoors (multiplies pybullet's render) and sky colours, from night to noon.
 NIGHT_LEVEL = 0.12
@@ -96,6 +101,18 @@ def black_body(kelvin: float) -> RGB:
     blue = 255.0 if t >= 66 else 0.0 if t <= 19 else 138.5177312231 * math.log(t - 10) - 305.0447927307
     red, green, blue = (min(max(c, 0.0), 255.0) / 255.0 for c in (red, green, blue))
     return (red, green, blue)
+
+
+class RollbackError(RuntimeError):
+    """A change failed half-way and putting back what it had changed failed too: the world is neither as
+    it was nor as asked. ``stuck`` names each item that could not be put back, with why; ``cause`` is
+    the error that stopped the change."""
+
+    def __init__(self, cause: BaseException, stuck: list[tuple[str, Exception]]) -> None:
+        self.cause, self.stuck = cause, list(stuck)
+        items = "; ".join(f"{item} ({type(e).__name__}: {e})" for item, e in self.stuck)
+        super().__init__(f"an appearance change failed ({type(cause).__name__}: {cause}) and putting it back "
+                         f"failed too, so the world is neither as it was nor as asked; not put back: {items}")
 
 
 class Appearance:
@@ -177,15 +194,23 @@ class Appearance:
 
         All or nothing: every item of ``target`` is checked before anything moves, and should a change
         still fail half-way (pybullet, a full disk under the asset cache) the items already changed are
-        put back, so the world, its state and its footprint are as they were before the call."""
+        put back, so the world, its state and its footprint are as they were before the call. Should
+        putting an item back fail too, every other item is still put back, the error is logged and
+        :class:`RollbackError` (naming what could not be put back) is raised from the first error."""
         self.check(target)
         before = self.state.settings()
         try:
             self._bring(target)
-        except BaseException:
-            with contextlib.suppress(Exception):      # the first error is the one to report
-                self._bring(before)
-            raise
+        except BaseException as error:
+            stuck: list[tuple[str, Exception]] = []
+            self._bring(before, stuck)
+            if not stuck:
+                raise
+            failure = RollbackError(error, stuck)
+            log.error("%s", failure)
+            if not isinstance(error, Exception):      # an interrupt stays an interrupt (it was logged)
+                raise
+            raise failure from error
 
     def check(self, target: Resolved) -> None:
         """Refuse (UserError) a target this world cannot show: an unknown item, an unknown paint, a
@@ -269,25 +294,35 @@ class Appearance:
         self.check(target)
         return target
 
-    def _bring(self, target: Resolved) -> None:
+    def _bring(self, target: Resolved, stuck: list[tuple[str, Exception]] | None = None) -> None:
         """Change the items of ``target`` that differ, in the house's order (knobs, lights, doors, paint,
-        models)."""
+        models). The first failure raises; with ``stuck`` (putting a failed change back) every item is
+        tried and each one that fails is added to ``stuck`` as (item, error) instead."""
+        def change(item: str, act: Callable[..., object], *args: Any) -> None:
+            if stuck is None:
+                act(*args)
+                return
+            try:
+                act(*args)
+            except Exception as e:
+                stuck.append((item, e))
+
         state = self.state
-        state.write(**{name: getattr(target, name) for name in KNOBS})
+        change("the global knobs", lambda: state.write(**{name: getattr(target, name) for name in KNOBS}))
         lights, doors, paint, models = target.lights, target.doors, target.paint, target.models
-        for lid in state.lights:
+        for lid in list(state.lights):
             if lid in lights and lights[lid] != state.lights[lid]:
-                self.set_light(lid, lights[lid])
-        for did, is_open in state.doors.items():
+                change(f"light {lid}", self.set_light, lid, lights[lid])
+        for did, is_open in list(state.doors.items()):
             if did in doors and doors[did] != is_open:
-                self.set_door(did, doors[did])
-        for room_id, surfaces in state.paint.items():
-            for surface, paint_now in surfaces.items():
+                change(f"door {did}", self.set_door, did, doors[did])
+        for room_id, surfaces in list(state.paint.items()):
+            for surface, paint_now in list(surfaces.items()):
                 if surface in paint.get(room_id, {}) and paint[room_id][surface] != paint_now:
-                    self.set_paint(room_id, surface, paint[room_id][surface])
-        for oid, model in state.models.items():
+                    change(f"paint {room_id}.{surface}", self.set_paint, room_id, surface, paint[room_id][surface])
+        for oid, model in list(state.models.items()):
             if oid in models and models[oid] != model:
-                self.set_object_model(oid, models[oid])
+                change(f"model of {oid} (index {models[oid]})", self.set_object_model, oid, models[oid])
 
     def _lights_named(self, which: str) -> list[str]:
         """The lights of a group (LIGHT_GROUPS) or the one light named ``which``."""
