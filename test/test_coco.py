@@ -49,26 +49,71 @@ def test_pycocotools_reads_the_export_back_with_our_masks(exported):
     assert checked > 20
 
 
-def test_pycocotools_evaluates_the_ground_truth_as_perfect_detections(exported):
-    from pycocotools.coco import COCO
+def _our_detections(root, ds, gt) -> list[dict]:
+    """Detections made here from the dataset's own instance images, without the export: our RLE masks
+    and boxes, the category found by the object's type among the export's category names, the image
+    by its RGB file. Scored against the export, they find any export that disagrees with the data."""
+    from pycocotools import mask as mask_utils
+    category = {c["name"]: c["id"] for c in gt.loadCats(gt.getCatIds())}
+    image_of = {image["file_name"]: image["id"] for image in gt.loadImgs(gt.getImgIds())}
+    found = []
+    for sample in ds:
+        ids = sample.instance
+        for i in np.unique(ids):
+            row = ds.instances.get(int(i))
+            if row is None or row["kind"] != "object":
+                continue
+            mask = ids == i
+            rows, cols = np.nonzero(mask)
+            rle = mask_utils.encode(np.asfortranarray(mask, dtype=np.uint8))
+            found.append({"image_id": image_of[str(sample.files["rgb"].relative_to(root))],
+                          "category_id": category[row["type"]], "score": 1.0,
+                          "segmentation": {"size": rle["size"], "counts": rle["counts"].decode("ascii")},
+                          "bbox": [float(cols.min()), float(rows.min()), float(cols.max() - cols.min() + 1),
+                                   float(rows.max() - rows.min() + 1)]})
+    return found
+
+
+def _scores(gt, detections: list[dict], kind: str) -> np.ndarray:
+    """pycocotools' 12 summary numbers (AP, AP50, AP75, ..., AR@100, ...) of ``detections``."""
     from pycocotools.cocoeval import COCOeval
-    root, _ = exported
-    gt = COCO(str(root / "coco" / "instances.json"))
-    results = [{"image_id": a["image_id"], "category_id": a["category_id"], "segmentation": a["segmentation"],
-                "score": 1.0} for a in gt.dataset["annotations"]]
-    for kind in ("segm", "bbox"):
-        if kind == "bbox":
-            results = [{**r, "bbox": a["bbox"]} for r, a in zip(results, gt.dataset["annotations"])]
-            for r in results:
-                del r["segmentation"]
-        evaluator = COCOeval(gt, gt.loadRes(results), kind)
-        evaluator.evaluate(), evaluator.accumulate()
-        evaluator.summarize()
-        assert evaluator.stats[1] == pytest.approx(1.0)          # AP at IoU 0.5
-    half = results[::2]                                          # half the boxes: recall drops
-    evaluator = COCOeval(gt, gt.loadRes(half), "bbox")
+    shown = [{k: v for k, v in d.items() if k != ("bbox" if kind == "segm" else "segmentation")} for d in detections]
+    evaluator = COCOeval(gt, gt.loadRes(shown), kind)
     evaluator.evaluate(), evaluator.accumulate(), evaluator.summarize()
-    assert evaluator.stats[8] < 0.9                              # AR@100
+    return evaluator.stats
+
+
+def test_detections_made_from_the_dataset_score_perfectly_against_the_export(exported):
+    from pycocotools.coco import COCO
+    root, ds = exported
+    gt = COCO(str(root / "coco" / "instances.json"))
+    ours = _our_detections(root, ds, gt)
+    assert len(ours) == len(gt.dataset["annotations"]) > 20
+    for kind in ("segm", "bbox"):
+        assert _scores(gt, ours, kind)[0] == pytest.approx(1.0), kind            # AP over IoU 0.5-0.95
+
+
+def test_degraded_detections_score_what_they_should(exported):
+    """Detections worse in a known way get the AP that way predicts, so the evaluation can tell."""
+    from pycocotools.coco import COCO
+    root, ds = exported
+    gt = COCO(str(root / "coco" / "instances.json"))
+    ours = _our_detections(root, ds, gt)
+    # boxes half as wide, inside their object's: IoU exactly 1/2, a hit at IoU 0.5 and a miss from 0.55 on
+    # (twice as wide: the same IoU, but reaches into neighbours: one matches the kitchen unit beside it at 0.55)
+    narrow = [{**d, "bbox": [d["bbox"][0], d["bbox"][1], d["bbox"][2] / 2, d["bbox"][3]]} for d in ours]
+    ap, ap50, ap75 = _scores(gt, narrow, "bbox")[:3]
+    assert (ap, ap50, ap75) == (pytest.approx(0.1), pytest.approx(1.0), pytest.approx(0.0))
+    # every other category left out: those categories score 0, the rest 1
+    categories = sorted({d["category_id"] for d in ours})
+    kept = set(categories[::2])
+    assert len(categories) >= 4
+    some = [d for d in ours if d["category_id"] in kept]
+    assert _scores(gt, some, "segm")[0] == pytest.approx(len(kept) / len(categories))
+    # every detection given the next category: nothing is found
+    shifted = [{**d, "category_id": categories[(categories.index(d["category_id"]) + 1) % len(categories)]}
+               for d in ours]
+    assert _scores(gt, shifted, "segm")[0] == pytest.approx(0.0)
 
 
 def test_semantic_images_lie_beside_the_instance_images_with_stable_ids(exported):

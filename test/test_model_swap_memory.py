@@ -11,6 +11,7 @@ import json
 import subprocess
 import sys
 
+import pybullet as pb
 import pytest
 from conftest import ROOT, subprocess_env
 
@@ -106,17 +107,27 @@ def test_model_swaps_rendered_by_the_gl_renderer_grow_nothing():
 # ------------------------------------------------------------------ what the World keeps
 
 def test_a_swapped_out_model_is_parked_out_of_the_house_and_comes_back(world, appearance):
+    c = world.client
     body, pose = world.instance("Bed_0").body, world.object_pose("Bed_0")
     start = world.state.models["Bed_0"]
     other = (start + 1) % 2
     appearance.set_object_model("Bed_0", other)
     swapped = world.instance("Bed_0").body
     assert swapped != body and body not in world.visuals and swapped in world.visuals
-    hits, _ = world.cast_rays([[*pose[0][:2], 3.0]], [[*pose[0][:2], -1.0]])
-    assert hits[0] != body                                   # the parked body is out of every ray's way
+    # a ray down through the bed hits the new model; with the new model hidden from it, the old body would
+    # be next in its way if it had stayed: it hits neither, and a ray through the parking spot hits it
+    (x, y, z), _ = pose
+    down = ([[x, y, z + 3.0]], [[x, y, world.floor_z - 1.0]])
+    assert world.cast_rays(*down)[0][0] == swapped
+    assert world.cast_rays(*down, mask=world.ray_mask([swapped]))[0][0] not in (body, swapped)
+    parked = z - OPEN_DOOR_DROP
+    assert world.cast_rays([[x, y, parked + 3.0]], [[x, y, parked - 3.0]])[0][0] == body
+    assert pb.getBasePositionAndOrientation(body, physicsClientId=c)[0] == pytest.approx((x, y, parked))
+    assert world.object_pose("Bed_0")[0][2] > world.floor_z - 1.0               # the new model is in the house
     appearance.set_object_model("Bed_0", start)
     assert world.instance("Bed_0").body == body and world.object_pose("Bed_0") == pose
     assert swapped not in world.visuals
+    assert pb.getBasePositionAndOrientation(swapped, physicsClientId=c)[0][2] < world.floor_z - OPEN_DOOR_DROP / 2
     for model in range(model_count(world.house.object("Bed_0"))):
         appearance.set_object_model("Bed_0", model)
     count = world.body_to_instance_lut().size
@@ -124,15 +135,28 @@ def test_a_swapped_out_model_is_parked_out_of_the_house_and_comes_back(world, ap
         appearance.change(parse({"models": {"Bed_0": "random"}, "seed": seed}))
     appearance.set_object_model("Bed_0", other)
     assert world.body_to_instance_lut().size == count
-    assert world.object_pose("Bed_0")[0][2] > world.floor_z - 1.0 > pose[0][2] - OPEN_DOOR_DROP
 
 
 def test_the_gl_scene_builder_keeps_only_models_the_world_shows(world, appearance):
+    """Every model an object has shown is remembered here, by (object, model index); after each swap the
+    builder keeps the arrays of none of those the state no longer shows (worked out from the state, not
+    from the World's visuals, which the builder itself reads)."""
     from ravh_sim.render.geometry import SceneBuilder
     from ravh_sim.render.materials import MaterialTable
     builder = SceneBuilder(world, MaterialTable())
+    sources: dict[tuple[str, int], int] = {}                  # (object, model) -> id of what draws it
+    objects = [inst for inst in world.instances if inst.kind == "object"]
+    forgotten = 0
     for seed in range(6):
         appearance.change(parse({"models": {"all": "random"}, "seed": seed}))
         builder.build()
-        shown = {id(v.model if v.model is not None else v.mesh) for v in world.visuals.values()} - {id(None)}
-        assert set(builder._arrays) <= shown                     # swapped-out (parked) models: forgotten
+        models = world.state.models
+        for inst in objects:
+            visual = world.visuals[inst.body]
+            sources[inst.name, models[inst.name]] = id(visual.model if visual.model is not None else visual.mesh)
+        shown = {key for (name, model), key in sources.items() if models[name] == model}
+        swapped_out = {key for (name, model), key in sources.items() if models[name] != model} - shown
+        assert shown <= set(builder._arrays)                   # what is drawn has its arrays
+        assert not swapped_out & set(builder._arrays), seed     # swapped-out (parked) models: forgotten
+        forgotten += len(swapped_out)
+    assert forgotten > 20                                      # the seeds did swap models out
