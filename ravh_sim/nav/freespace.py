@@ -8,14 +8,15 @@ agrees with the pybullet world by construction. Three steps, each its own functi
    them (:func:`ravh_sim.world.structure.solid_walls`), columns, closed door
    leaves and the furniture parts that the robot's body would hit (legs, seats, a table top below
    the robot's height: :mod:`ravh_sim.world.solids`, the parts the world collides with) are
-   OCCUPIED; the rest is FREE.
+   OCCUPIED; the rest is FREE. A part is its box (``Placed.footprints``: a library model's largest
+   pieces), so this map is conservative: it blocks the floor under a chair's seat, between its legs.
 2. :func:`inflate` grows every non-free cell by the robot radius (a disc), so a FREE cell is a
    position where the whole robot disc fits: the planner can then treat the robot as a point.
 3. :func:`free_space` chains the two; :func:`ravh_sim.nav.grid.distance_to_obstacle` gives the
    clearance the planner uses to keep paths away from walls where there is room.
 
 Rasterisation uses cv2 polygon filling on sub-pixel coordinates: a few hundred shapes per house take
-milliseconds. An obstacle covers the cells whose centre lies inside it (see :func:`_fill_box`: house
+milliseconds. An obstacle covers the cells whose centre lies inside it (see :func:`fill_box`: house
 coordinates sit on cell edges, and cv2's own rounding would narrow every 0.8 m corridor by a cell),
 and a shape thinner than a cell still covers a line of cells, so no wall is lost at any resolution.
 
@@ -23,6 +24,9 @@ Why the union of floors: neighbouring floor polygons meet under each doorway (ea
 way through the threshold), so the known area is connected exactly where the walls have gaps;
 open doors' frame boxes are added to the known area as well, so a doorway never depends on floor
 outlines meeting to the last centimetre.
+
+This is not /map: the obstacle map a ROS user's AMCL or SLAM sees (:mod:`ravh_sim.nav.obstaclemap`)
+is the house cut at the laser's height, what the laser hits, on the same grid (:func:`floor_grid`).
 """
 from __future__ import annotations
 
@@ -47,8 +51,8 @@ MIN_OBSTACLE_TOP = 0.02
 """Parts whose top is at most this high above the floor (rugs, thresholds) do not block."""
 
 MIN_DOOR_THICKNESS = 0.1
-_SHIFT = 8                                  # cv2 fixed-point fraction bits
-_SCALE = 1 << _SHIFT
+SHIFT = 8                                   # cv2 fixed-point fraction bits (see :func:`pixels`)
+SCALE = 1 << SHIFT
 
 
 def free_space(house: House, door_open: Mapping[str, bool], models: Mapping[str, int] | None = None,
@@ -73,8 +77,20 @@ def obstacles(house: House, door_open: Mapping[str, bool], models: Mapping[str, 
     if resolution <= 0 or height <= 0 or margin < 0:
         raise ValueError(f"need resolution > 0, height > 0, margin >= 0; got {resolution}, "
                          f"{height}, {margin}")
-    open_state = _door_states(house, door_open)
-    models = _checked_models(house, models or {})
+    open_state = door_states(house, door_open)
+    models = checked_models(house, models or {})
+    grid = floor_grid(house, open_state, resolution, margin)
+    blocked = np.zeros(grid.shape, np.uint8)
+    for box in _obstacle_boxes(house, open_state, models, height, resolution):
+        fill_box(blocked, box, grid)
+    grid.data[blocked > 0] = OCCUPIED
+    return grid
+
+
+def floor_grid(house: House, open_state: Mapping[str, bool], resolution: float, margin: float) -> Grid:
+    """The known floor FREE (the union of the room floors and of open doorways), the rest UNKNOWN, on a
+    grid over ``house.bounds`` plus ``margin`` aligned to ``resolution``; ``open_state`` as
+    :func:`door_states` gives it."""
     grid = _empty_grid(house, resolution, margin)
     known = np.zeros(grid.shape, np.uint8)
     for room in house.rooms:
@@ -82,12 +98,8 @@ def obstacles(house: House, door_open: Mapping[str, bool], models: Mapping[str, 
             _fill_polygon(known, poly, grid)
     for door in house.doors:
         if open_state[door.id]:
-            _fill_box(known, _door_box(door), grid)
-    blocked = np.zeros(grid.shape, np.uint8)
-    for box in _obstacle_boxes(house, open_state, models, height, resolution):
-        _fill_box(blocked, box, grid)
+            fill_box(known, _door_box(door), grid)
     grid.data[known > 0] = FREE
-    grid.data[blocked > 0] = OCCUPIED
     return grid
 
 
@@ -118,7 +130,7 @@ def _obstacle_boxes(house: House, open_state: Mapping[str, bool], models: Mappin
     for wall in (w for room in house.rooms for w in solid_walls(house, room.id)):
         base = floor_z[wall.room]
         if wall.z0 < base + height and wall.z1 > base:
-            yield _wall_box(wall)
+            yield wall_box(wall)
     for door in house.doors:
         if not open_state[door.id]:
             yield _door_box(door)
@@ -129,7 +141,7 @@ def _obstacle_boxes(house: House, open_state: Mapping[str, bool], models: Mappin
             yield from placed.footprints(base + MIN_OBSTACLE_TOP, base + height, resolution)
 
 
-def _wall_box(wall: Wall) -> Box:
+def wall_box(wall: Wall) -> Box:
     (ax, ay), (bx, by) = wall.a, wall.b
     return ((ax + bx) / 2, (ay + by) / 2), (wall.length, wall.thickness), math.atan2(by - ay, bx - ax)
 
@@ -152,10 +164,10 @@ def _empty_grid(house: House, resolution: float, margin: float) -> Grid:
 
 def _fill_polygon(mask: np.ndarray, outline: Sequence[tuple[float, float]], grid: Grid) -> None:
     """Set to 1 every cell of ``mask`` that the polygon ``outline`` (metres) touches."""
-    cv2.fillPoly(mask, [_pixels(np.asarray(outline), grid)], 1, lineType=cv2.LINE_8, shift=_SHIFT)
+    cv2.fillPoly(mask, [pixels(np.asarray(outline), grid)], 1, lineType=cv2.LINE_8, shift=SHIFT)
 
 
-def _fill_box(mask: np.ndarray, box: Box, grid: Grid) -> None:
+def fill_box(mask: np.ndarray, box: Box, grid: Grid) -> None:
     """Set to 1 the cells of ``mask`` whose centre lies in ``box``; a box thinner than a cell is
     drawn as a line one cell wide, so no wall is ever lost between cell centres.
 
@@ -166,25 +178,25 @@ def _fill_box(mask: np.ndarray, box: Box, grid: Grid) -> None:
     center, (length, width), yaw = box
     shrunk = (max(length - grid.resolution, 0.0), max(width - grid.resolution, 0.0))
     corners = box_corners(center, shrunk, yaw)
-    cv2.fillConvexPoly(mask, _pixels(corners, grid), 1, lineType=cv2.LINE_8, shift=_SHIFT)
+    cv2.fillConvexPoly(mask, pixels(corners, grid), 1, lineType=cv2.LINE_8, shift=SHIFT)
 
 
-def _pixels(points: np.ndarray, grid: Grid) -> np.ndarray:
+def pixels(points: np.ndarray, grid: Grid) -> np.ndarray:
     """cv2 fixed-point pixel coordinates of (n, 2) points in metres: cell centres on integers."""
-    pixels = (points - np.asarray(grid.origin)) / grid.resolution - 0.5
-    return np.round(pixels * _SCALE).astype(np.int32)
+    at = (points - np.asarray(grid.origin)) / grid.resolution - 0.5
+    return np.round(at * SCALE).astype(np.int32)
 
 
 # --------------------------------------------------------------------------- arguments
 
-def _door_states(house: House, door_open: Mapping[str, bool]) -> dict[str, bool]:
+def door_states(house: House, door_open: Mapping[str, bool]) -> dict[str, bool]:
     unknown = [d for d in door_open if d not in house.door_by_id]
     if unknown:
         raise UnknownNameError("door", unknown[0], list(house.door_by_id))
     return {d.id: bool(door_open.get(d.id, d.default_open)) for d in house.doors}
 
 
-def _checked_models(house: House, models: Mapping[str, int]) -> Mapping[str, int]:
+def checked_models(house: House, models: Mapping[str, int]) -> Mapping[str, int]:
     unknown = [o for o in models if o not in house.object_by_id]
     if unknown:
         raise UnknownNameError("object", unknown[0], list(house.object_by_id))

@@ -3,8 +3,9 @@
 Why one place: the pybullet world draws an object as its parts merged and collides with each part
 (so the laser sees between table legs and hits a door leaf where the camera sees it), and the
 free-space map blocks the floor under the parts that a robot's body would hit (a table top blocks
-a tall robot; the empty corner of an L-shaped sofa does not). Physics, sensors and navigation then
-agree on every surface because they read the same parts.
+a tall robot; the empty corner of an L-shaped sofa does not), and the obstacle map (/map) is their cut
+at the laser's height (:meth:`Placed.section`). Physics, sensors and navigation then agree on every
+surface because they read the same parts.
 
 A :class:`Placed` object holds its model in its body frame (box centre at the origin, unrotated)
 and the body's pose; the world turns it by ``yaw`` about z and moves it to ``position``. The model is
@@ -77,6 +78,73 @@ class Placed:
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         for (mx, my), (hx, hy) in zip(middle.tolist(), half.tolist()):
             yield (x + c * mx - s * my, y + s * mx + c * my), (2 * hx, 2 * hy), self.yaw
+
+    def section(self, z: float) -> np.ndarray:
+        """Where the horizontal plane at height ``z`` (house frame) cuts the object as the collision world
+        has it, so where a planar laser at that height ends on it: (n, 2, 2) segments, two (x, y) ends
+        each, in the house frame (empty where nothing reaches the plane).
+
+        A procedural part collides as its convex hull (the world's ``_parts_collision``), so its cut is
+        the hull's outline, a closed convex polygon (one point or segment where the plane only touches
+        it); a library model collides as its own triangles (``_model_collision``), so its cut is where
+        the plane crosses them: closed outlines where the model is closed around that height, open
+        ones (an open shelf's front) where it is not.
+        """
+        local_z = z - self.position[2]
+        if self.model is not None:
+            local = _model_section(self.model, local_z)
+        else:
+            reach = (self.bounds[:, 0, 2] <= local_z + _ON_PLANE) & (self.bounds[:, 1, 2] >= local_z - _ON_PLANE)
+            cuts = [_hull_section(self.parts[i].vertices, local_z) for i in np.flatnonzero(reach)]
+            local = np.concatenate(cuts) if cuts else np.zeros((0, 2, 2))
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        return local @ np.array([[c, s], [-s, c]]) + np.asarray(self.position[:2], np.float64)
+
+
+_ON_PLANE = 1e-9                           # m: a vertex this close to a cutting plane lies in it
+
+
+def _hull_section(vertices: np.ndarray, z: float) -> np.ndarray:
+    """(k, 2, 2) edges of the convex polygon where the plane at height ``z`` cuts the convex hull of
+    ``vertices``: the hull of the vertices in the plane and of the crossings of every segment from a
+    vertex above it to one below (the cut of a convex hull is the hull of those points)."""
+    height = vertices[:, 2] - z
+    above, below = vertices[height > _ON_PLANE], vertices[height < -_ON_PLANE]
+    da, db = above[:, None, 2] - z, below[None, :, 2] - z                      # (a, 1) > 0, (1, b) < 0
+    crossings = above[:, None, :2] + (da / (da - db))[..., None] * (below[None, :, :2] - above[:, None, :2])
+    points = np.concatenate([vertices[np.abs(height) <= _ON_PLANE, :2], crossings.reshape(-1, 2)])
+    if not len(points):
+        return np.zeros((0, 2, 2))
+    hull = _convex_hull(points)
+    return np.stack([hull, np.roll(hull, -1, axis=0)], axis=1)
+
+
+def _convex_hull(points: np.ndarray) -> np.ndarray:
+    """(k, 2) corners of the convex hull of (n, 2) points, counter-clockwise (Andrew's monotone chain;
+    collinear points dropped, so a flat set gives its two ends and a single point itself)."""
+    unique = np.unique(points, axis=0)                       # sorted by x, then y
+    if len(unique) < 3:
+        return unique
+
+    def chain(ordered: np.ndarray) -> list[np.ndarray]:
+        kept: list[np.ndarray] = []
+        for p in ordered:
+            while len(kept) >= 2 and ((kept[-1][0] - kept[-2][0]) * (p[1] - kept[-2][1])
+                                      - (kept[-1][1] - kept[-2][1]) * (p[0] - kept[-2][0])) <= 0:
+                kept.pop()
+            kept.append(p)
+        return kept[:-1]
+
+    return np.array(chain(unique) + chain(unique[::-1]))
+
+
+def _model_section(fitted: library.FittedModel, z: float) -> np.ndarray:
+    """(n, 2, 2) segments where the plane at height ``z`` (body frame) crosses a library model's triangles."""
+    heights = fitted.vertices[:, 2]
+    if not heights.min() <= z <= heights.max():
+        return np.zeros((0, 2, 2))
+    segments = trimesh.intersections.mesh_plane(fitted.mesh, (0.0, 0.0, 1.0), (0.0, 0.0, z))
+    return np.asarray(segments, np.float64).reshape(-1, 2, 3)[:, :, :2]
 
 
 def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
