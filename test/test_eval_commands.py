@@ -9,6 +9,7 @@ from evaldata import small_dataset
 
 from ravh_sim.cli import main
 from ravh_sim.eval.semantic_map import read_map
+from ravh_sim.paper import TABLE3, read_tsv
 
 
 def test_oracle_map_then_evaluation(capsys, tmp_path_factory, tmp_path):
@@ -45,8 +46,40 @@ def test_the_paper_row_stands_beside_ours(capsys, tmp_path_factory, tmp_path):
     lines = text[text.index("CNN detections"):].splitlines()
     ours = read_map(tmp_path / "m.json")
     assert _columns(lines[1])[:4] == ["20", "ours", str(ours.detections), str(len(ours.boxes))]
-    assert _columns(lines[2]) == ["paper", "54", "6", "7", "83.3", "43.8"]           # Table 3, house 20
-    assert _columns(lines[-1]) == ["mean", "paper", "54.0", "6.0", "7.0", "83.3", "43.8"]
+    paper = next(r for r in read_tsv(TABLE3) if r["house"] == "20")                 # config/paper's Table 3
+    theirs = [paper[k] for k in ("cnn_detections", "detection_boxes", "detected_objects", "precision_pct",
+                                 "recall_pct")]
+    assert _columns(lines[2]) == ["paper"] + theirs
+    mine = _columns(lines[1])[2:]
+    assert _columns(_line(lines, "mean paper")) == ["mean", "paper"] + [f"{float(v):.1f}" for v in theirs]
+    assert _columns(_line(lines, "mean ours")) == ["mean", "ours"] + [f"{float(v):.1f}" for v in mine]
+    assert _columns(_line(lines, "ratio ours / paper"))[4:] == [
+        f"{round(float(a), 1) / round(float(b), 1):.2f}x" for a, b in zip(mine, theirs)]
+    assert _columns(_line(lines, "range paper")) == ["range", "paper"] + [f"{v}-{v}" for v in theirs]
+    assert _columns(_line(lines, "range ours")) == ["range", "ours"] + [f"{v}-{v}" for v in mine]
+
+
+def _line(lines: list[str], start: str) -> str:
+    [line] = [line for line in lines if " ".join(line.split()).startswith(start)]
+    return line
+
+
+def test_several_houses_beside_the_paper_give_means_ratios_and_ranges():
+    from ravh_sim.eval.semantic_eval import format_beside_paper
+    paper = {int(r["house"]): r for r in read_tsv(TABLE3)}
+    houses = [{"house": h, "detections": 100 * h, "boxes": 10 + h, "found": 8 + h, "precision": 0.5 + h / 100,
+               "recall": 0.2 + h / 100} for h in (1, 2, 3)]
+    lines = format_beside_paper({"houses": houses}, paper, "oracle").splitlines()
+    theirs = [[float(paper[h][k]) for h in (1, 2, 3)] for k in ("cnn_detections", "detection_boxes",
+                                                                 "detected_objects", "precision_pct", "recall_pct")]
+    means = [round(sum(col) / 3, 1) for col in theirs]
+    assert _columns(_line(lines, "mean paper"))[2:] == [f"{m:.1f}" for m in means]
+    assert _columns(_line(lines, "mean oracle"))[2:] == ["200.0", "12.0", "10.0", "52.0", "22.0"]
+    assert _columns(_line(lines, "ratio oracle / paper"))[4:] == [
+        f"{a / b:.2f}x" for a, b in zip((200.0, 12.0, 10.0, 52.0, 22.0), means)]
+    spans = [(f"{min(c):.1f}-{max(c):.1f}" if k >= 3 else f"{int(min(c))}-{int(max(c))}") for k, c in enumerate(theirs)]
+    assert _columns(_line(lines, "range paper"))[2:] == spans
+    assert _columns(_line(lines, "range oracle"))[2:] == ["100-300", "11-13", "9-11", "51.0-53.0", "21.0-23.0"]
 
 
 def test_paper_protocol_maps_each_houses_raid_with_both_mappers(capsys, tmp_path_factory, tmp_path):
@@ -59,6 +92,10 @@ def test_paper_protocol_maps_each_houses_raid_with_both_mappers(capsys, tmp_path
     degraded = json.loads((out / "table3_degraded.json").read_text())["houses"][0]
     assert oracle["house"] == degraded["house"] == 20 and oracle["recall"] > degraded["recall"]
     assert (out / "table3_paper.txt").read_text().strip() == text.strip()
+    for mapper, doc in (("oracle", oracle), ("degraded", degraded)):
+        [row] = [line.split() for line in (out / f"table3_{mapper}.txt").read_text().splitlines()
+                 if line.startswith("house 20")]
+        assert row[2:5] == [str(doc["boxes"]), str(doc["correct"]), f"{doc['precision']:.3f}"]
 
 
 @pytest.mark.parametrize("argv, needle", [
@@ -69,8 +106,13 @@ def test_paper_protocol_maps_each_houses_raid_with_both_mappers(capsys, tmp_path
     (["eval", "semantic-map"], "or --paper-protocol"),
     (["eval", "semantic-map", "--paper-protocol"], "needs --out"),
     (["eval", "semantic-map", "--paper-protocol", "--out", "o", "--mappers", "cnn"], "--mappers"),
+    (["eval", "localization", "--out", "o", "--paper", "nowhere.tsv"], "--paper: no such file"),
+    (["eval", "localization", "--out", "o", "--paper", "bad.tsv"], "not Table 4's columns"),
+    (["eval", "localization", "--out", "o", "--descriptor", "nothing"], "expected gradient_grid or constant"),
+    (["eval", "localization", "--out", "o", "--house", "99"], "99"),
 ])
 def test_user_errors(capsys, tmp_path, monkeypatch, argv, needle):
     monkeypatch.chdir(tmp_path)
+    (tmp_path / "bad.tsv").write_text("route\tmap\nday\tday\n")
     assert main(argv) == 2
     assert needle in capsys.readouterr().err

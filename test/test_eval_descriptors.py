@@ -42,6 +42,14 @@ def test_plug_in_by_name_and_callable():
     assert d.shape == (2, 3) and np.allclose(np.linalg.norm(d, axis=1), 1.0)
 
 
+def test_built_in_descriptors_by_name():
+    assert load_descriptor("gradient_grid") == (BASELINE, gradient_grid)
+    name, blind = load_descriptor("constant")
+    assert name == "constant"
+    d = describe([_scene(1), _scene(2)], blind)                 # sees nothing: every image alike
+    assert np.array_equal(d[0], d[1])
+
+
 @pytest.mark.parametrize("spec, needle", [("nothing", "module:function"), ("no_such_module_x:f", "cannot load"),
                                           ("numpy:no_such_function_x", "cannot load"), ("numpy:pi", "not callable")])
 def test_bad_plug_ins(spec, needle):

@@ -6,7 +6,7 @@ import json
 import sys
 from pathlib import Path
 
-from ravh_sim.paper import TABLE3
+from ravh_sim.paper import TABLE3, TABLE4
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -44,11 +44,16 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="folder for the recordings (reused when present), table4.json/.txt/.png")
     p.add_argument("--quick", action="store_true", help="CI-sized: 2 short routes, 2 maps of the grid nodes along them")
     p.add_argument("--descriptor", default=None,
-                   help="'module:function' (RGB image -> vector); default: the gradient_grid baseline")
+                   help="gradient_grid (the default baseline), constant (sees nothing: odometry alone) or "
+                        "'module:function' (RGB image -> vector)")
     p.add_argument("--seed", type=int, default=0, help="seed of the recordings and the odometry noise")
     p.add_argument("--night-lights", choices=("evening", "all"), default="evening",
                    help="night recordings: evening (default: each its own fair coin per light, as a home on "
                         "different evenings) or all (every ceiling light on)")
+    p.add_argument("--paper", type=Path, default=TABLE4, metavar="TSV",
+                   help="the paper's Table 4 to set beside ours (default: config/paper/table4_localization.tsv)")
+    p.add_argument("--json", action="store_true", help="print table4.json (ours, the paper's, ratios) instead of "
+                                                       "the text table")
     p.set_defaults(func=cmd_eval_localization)
 
 
@@ -106,12 +111,23 @@ def _paper_protocol(args: argparse.Namespace, threshold: float, paper_path: Path
 def cmd_eval_localization(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
+    from ravh_sim.errors import UserError
     from ravh_sim.eval.table4 import FULL, QUICK, format_table4, run_table4
+    from ravh_sim.paper import table4
     from ravh_sim.world.house import load_house
     load_house(args.house)                            # unknown house: the usual clear error
     protocol = replace(QUICK if args.quick else FULL, night_lights=args.night_lights)
+    if not args.paper.is_file():
+        raise UserError(f"--paper: no such file {args.paper}")
+    try:                                              # a bad table fails now, not after the recordings
+        table4(args.paper)
+    except (KeyError, ValueError) as e:
+        raise UserError(f"--paper {args.paper}: not Table 4's columns (config/paper/README.md): {e}") from None
     doc = run_table4(args.house, args.out, protocol, args.descriptor, args.seed,
-                     progress=lambda text: print(text, file=sys.stderr, flush=True))
-    print(format_table4(doc))
-    print(f"wrote {args.out / 'table4.json'} and {args.out / 'table4.png'}")
+                     progress=lambda text: print(text, file=sys.stderr, flush=True), paper=args.paper)
+    if args.json:
+        print(json.dumps(doc, indent=1))
+    else:
+        print(format_table4(doc))
+        print(f"wrote {args.out / 'table4.json'}, table4.txt and table4.png")
     return 0

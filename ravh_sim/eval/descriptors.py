@@ -49,17 +49,25 @@ def gradient_grid(image: np.ndarray) -> np.ndarray:
     return np.sqrt(hist).ravel()
 
 
+def constant(image: np.ndarray) -> np.ndarray:
+    """A descriptor that sees nothing: every image alike, so a localizer has only the odometry."""
+    return np.ones(1)
+
+
 BASELINE = "gradient_grid"
+BUILT_IN: dict[str, Descriptor] = {BASELINE: gradient_grid, "constant": constant}
 
 
 def load_descriptor(spec: str | None) -> tuple[str, Descriptor]:
-    """(name, callable) for ``spec``: None or 'gradient_grid' is the baseline, 'module:function'
-    imports a user's callable."""
-    if spec in (None, BASELINE):
+    """(name, callable) for ``spec``: None is the baseline, a name of :data:`BUILT_IN` that
+    descriptor, 'module:function' imports a user's callable."""
+    if spec is None:
         return BASELINE, gradient_grid
+    if spec in BUILT_IN:
+        return spec, BUILT_IN[spec]
     module_name, _, attr = spec.partition(":")
     if not attr:
-        raise UserError(f"descriptor {spec!r}: expected {BASELINE} or 'module:function'")
+        raise UserError(f"descriptor {spec!r}: expected {' or '.join(BUILT_IN)} or 'module:function'")
     try:
         function = getattr(importlib.import_module(module_name), attr)
     except (ImportError, AttributeError) as e:

@@ -191,7 +191,8 @@ def paper_columns(row: dict[str, Any]) -> tuple[Any, ...]:
 
 def format_beside_paper(doc: dict[str, Any], paper: dict[int, dict[str, str]], label: str = "ours") -> str:
     """Table 3's columns per house, our row and the paper's (``paper``: house -> its TSV row) beside it,
-    then the mean of each over the houses in both."""
+    then over the houses in both: the mean of each, ours over the paper's, and the range (lowest-highest
+    house) of each."""
     head = f"{'house':<7}{'':<16}" + "".join(f"{c:>17}" for c in PAPER_COLUMNS)
     lines = [head]
     ours_rows, theirs_rows = [], []
@@ -205,10 +206,22 @@ def format_beside_paper(doc: dict[str, Any], paper: dict[int, dict[str, str]], l
             lines.append(f"{'':<7}{'paper':<16}" + "".join(f"{_cell(v):>17}" for v in theirs))
             ours_rows.append(ours)
             theirs_rows.append(theirs)
+    means = {}
     for name, rows in ((label, ours_rows), ("paper", theirs_rows)):
-        means = [_mean([r[k] for r in rows]) for k in range(len(PAPER_COLUMNS))]
-        lines.append(f"{'mean':<7}{name:<16}" + "".join(f"{_cell(v):>17}" for v in means))
+        means[name] = [_mean([r[k] for r in rows]) for k in range(len(PAPER_COLUMNS))]
+        lines.append(f"{'mean':<7}{name:<16}" + "".join(f"{_cell(v):>17}" for v in means[name]))
+    ratios = [None if a is None or not b else f"{a / b:.2f}x" for a, b in zip(means[label], means["paper"])]
+    lines.append(f"{'ratio':<7}{label + ' / paper':<16}" + "".join(f"{_cell(v):>17}" for v in ratios))
+    for name, rows in ((label, ours_rows), ("paper", theirs_rows)):
+        spans = [_span([r[k] for r in rows]) for k in range(len(PAPER_COLUMNS))]
+        lines.append(f"{'range':<7}{name:<16}" + "".join(f"{_cell(v):>17}" for v in spans))
     return "\n".join(lines)
+
+
+def _span(values: list[Any]) -> str | None:
+    """'lowest-highest' of the known values."""
+    known = [v for v in values if v is not None]
+    return f"{_cell(min(known))}-{_cell(max(known))}" if known else None
 
 
 def _pct(v: float | None) -> float | None:

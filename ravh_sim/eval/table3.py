@@ -14,7 +14,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ravh_sim.eval.semantic_eval import DEFAULT_THRESHOLD, evaluate_datasets, format_beside_paper
+from ravh_sim.eval.semantic_eval import DEFAULT_THRESHOLD, evaluate_datasets, format_beside_paper, format_table
 from ravh_sim.eval.semantic_map import write_map
 from ravh_sim.paper import TABLE3, read_tsv
 from ravh_sim.raids.build import clear_unfinished, finished
@@ -37,8 +37,9 @@ def record_house(house: int, out: Path, seed: int) -> Path:
 def run_protocol(houses: list[int], out: Path, mappers: list[str], seed: int = 0,
                  threshold: float = DEFAULT_THRESHOLD, paper_path: Path = TABLE3,
                  progress: Callable[[str], None] = lambda text: None) -> dict[str, Any]:
-    """Record, map and evaluate every house; writes OUT/table3_<mapper>.json and OUT/table3_paper.txt and
-    returns {mapper: Table 3 document}."""
+    """Record, map and evaluate every house; writes OUT/table3_<mapper>.json and .txt (per house and type:
+    boxes, correct, detectable, found, ...) and OUT/table3_paper.txt (beside the paper) and returns
+    {mapper: Table 3 document}."""
     from ravh_sim.dataset.api import Dataset
     from ravh_sim.eval.mappers import run_mapper
     out.mkdir(parents=True, exist_ok=True)
@@ -59,6 +60,7 @@ def run_protocol(houses: list[int], out: Path, mappers: list[str], seed: int = 0
         doc = evaluate_datasets(pairs, threshold, out / "maps")
         doc["protocol"] = {"raid": "one wanderer round", "appearance": RANDOM_APPEARANCE, "seed": seed}
         (out / f"table3_{mapper}.json").write_text(json.dumps(doc, indent=1) + "\n")
+        (out / f"table3_{mapper}.txt").write_text(format_table(doc) + "\n")
         docs[mapper] = doc
         text.append(format_beside_paper(doc, paper, mapper))
     (out / "table3_paper.txt").write_text("\n\n".join(text) + "\n")

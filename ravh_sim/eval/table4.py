@@ -14,7 +14,12 @@ first route, captured in place. Every recording is an ordinary
 dataset under ``OUT/maps/`` and ``OUT/routes/``; a later run reuses recordings made with the same
 protocol and seed. Each route is localized against each map (:mod:`ravh_sim.eval.localization`)
 :data:`RUNS` times with different odometry noise; a cell of the table is the median over the runs
-of each run's median position error (m) and rotation error (deg).
+of each run's median position error (m) and rotation error (deg). Each cell also has its top-1
+retrieval (:func:`retrieval`: the share of route images whose most similar map image lies within
+:data:`TOP1_M` m and :data:`TOP1_DEG` degrees of the route image's true pose, no odometry), and the
+table sets the paper's cell (``config/paper/table4_localization.tsv``) beside each of ours, with the
+median of each map's column, each column against the first map's (day) and ours against the paper's
+(:func:`beside_paper`).
 """
 from __future__ import annotations
 
@@ -36,11 +41,13 @@ from ravh_sim.dataset.layout import RAID_JSON
 from ravh_sim.errors import UserError
 from ravh_sim.eval.descriptors import Descriptor, describe, load_descriptor
 from ravh_sim.eval.localization import Localizer, errors, noisy_odometry
+from ravh_sim.paper import TABLE4, TABLE4_METHOD, table4
 from ravh_sim.raids.direct import MAX_SIM_S, GridSpec, PosesSpec, WandererSpec, record
 from ravh_sim.viz.figure import figure_bgr, new_figure
 from ravh_sim.world.house import House, load_house
 
 RUNS = 5
+TOP1_M, TOP1_DEG = 1.0, 45.0       # a top-1 retrieval is right when the most similar map image is this close
 SPEED = 0.25                       # m/s, the Wanderer's cruise speed (the giraff profile's maximum)
 
 
@@ -85,8 +92,10 @@ QUICK = Protocol(maps=MAPS[::2], routes=(ROUTES[0], ROUTES[2]), route_m=8.0, map
 
 
 def run_table4(house: int, out: Path, protocol: Protocol = FULL, descriptor: str | Descriptor | None = None,
-               seed: int = 0, progress: Callable[[str], None] | None = None) -> dict[str, Any]:
-    """Record what is missing, localize every route on every map, write table4.json/.txt/.png."""
+               seed: int = 0, progress: Callable[[str], None] | None = None,
+               paper: Path | None = TABLE4) -> dict[str, Any]:
+    """Record what is missing, localize every route on every map, write table4.json/.txt/.png;
+    ``paper``: the paper's Table 4 (TSV) to set beside ours (None: ours alone)."""
     if callable(descriptor):
         name, function = getattr(descriptor, "__name__", "custom"), descriptor
     else:
@@ -122,9 +131,11 @@ def run_table4(house: int, out: Path, protocol: Protocol = FULL, descriptor: str
                 odometry = noisy_odometry(truth, np.random.default_rng([seed, run]))
                 position, rotation = errors(localizer.localize(route_desc, odometry), truth)
                 runs.append((float(np.median(position)), float(np.median(rotation))))
+            top1, nearest = retrieval(route_desc, truth, map_desc, map_poses)
             row.append({"route": r.label, "map": m.label,
                         "position_m": round(float(np.median([p for p, _ in runs])), 3),
                         "rotation_deg": round(float(np.median([a for _, a in runs])), 2),
+                        "top1_pct": round(top1, 1), "nearest_map_image_m": round(nearest, 3),
                         "runs": [{"position_m": round(p, 3), "rotation_deg": round(a, 2)} for p, a in runs]})
         cells.append(row)
     doc = {"house": house, "descriptor": name, "seed": seed, "runs": RUNS,
@@ -133,12 +144,67 @@ def run_table4(house: int, out: Path, protocol: Protocol = FULL, descriptor: str
            "routes": {r.label: {"images": len(routes[r]), "length_m": round(_length(route_side[r][1]), 2),
                                 "dataset": str(routes[r].dir)} for r in protocol.routes},
            "cells": cells,
+           "top1": {"within_m": TOP1_M, "within_deg": TOP1_DEG},
            "wall_s": {"record": round(recorded - started, 1), "evaluate": round(time.monotonic() - recorded, 1)}}
+    if paper is not None:
+        doc["paper"] = beside_paper(doc, table4(paper), paper)
     out.mkdir(parents=True, exist_ok=True)
     (out / "table4.json").write_text(json.dumps(doc, indent=1) + "\n")
     (out / "table4.txt").write_text(format_table4(doc) + "\n")
     cv2.imwrite(str(out / "table4.png"), draw_table4(doc))
     return doc
+
+
+def retrieval(route_descriptors: np.ndarray, truth: np.ndarray, map_descriptors: np.ndarray,
+              map_poses: np.ndarray) -> tuple[float, float]:
+    """(top-1 retrieval %, nearest map image m) of a route on a map: the share of route images whose
+    most similar map image (cosine similarity of the descriptors) lies within TOP1_M m and TOP1_DEG
+    degrees of the image's true pose; and the median over the route images of the distance to the
+    nearest map image's position (the floor the map's spacing sets for any localizer)."""
+    best = map_poses[np.argmax(route_descriptors @ map_descriptors.T, axis=1)]
+    turn = (best[:, 2] - truth[:, 2] + np.pi) % (2 * np.pi) - np.pi
+    near = (np.hypot(best[:, 0] - truth[:, 0], best[:, 1] - truth[:, 1]) <= TOP1_M) \
+        & (np.degrees(np.abs(turn)) <= TOP1_DEG)
+    gaps = np.hypot(truth[:, None, 0] - map_poses[None, :, 0], truth[:, None, 1] - map_poses[None, :, 1])
+    return 100.0 * float(np.mean(near)), float(np.median(gaps.min(axis=1)))
+
+
+def beside_paper(doc: dict[str, Any], paper: dict[tuple[str, str], tuple[float, float]],
+                 source: str | Path = TABLE4) -> dict[str, Any]:
+    """The paper's cell beside each of ours (None where the paper has no such route and map), and per
+    map the median position error of its column, ours and the paper's, each column's median over the
+    first map's (the day map: how much harder its light is) and ours over the paper's."""
+    maps = list(doc["maps"])
+    cells = [[None if (c["route"], c["map"]) not in paper else
+              {"route": c["route"], "map": c["map"], "position_m": paper[c["route"], c["map"]][0],
+               "rotation_deg": paper[c["route"], c["map"]][1],
+               "ours_over_paper": _ratio(c["position_m"], paper[c["route"], c["map"]][0])} for c in row]
+             for row in doc["cells"]]
+    columns: list[dict[str, Any]] = []
+    for j, m in enumerate(maps):
+        theirs = [cell["position_m"] for cell in (row[j] for row in cells) if cell is not None]
+        ours = round(float(np.median([row[j]["position_m"] for row in doc["cells"]])), 3)
+        median = round(float(np.median(theirs)), 3) if theirs else None
+        columns.append({"map": m, "ours_median_m": ours, "paper_median_m": median, "paper_routes": len(theirs),
+                        "ours_over_paper": _ratio(ours, median)})
+    for column in columns:
+        column["ours_over_first_map"] = _ratio(column["ours_median_m"], columns[0]["ours_median_m"])
+        column["paper_over_first_map"] = _ratio(column["paper_median_m"], columns[0]["paper_median_m"])
+    worst = {"ours": _worst([c for row in doc["cells"] for c in row]),
+             "paper": _worst([c for row in cells for c in row if c is not None])}
+    return {"source": str(source), "method": TABLE4_METHOD, "cells": cells, "columns": columns, "worst": worst}
+
+
+def _ratio(a: float | None, b: float | None) -> float | None:
+    return None if a is None or not b else round(a / b, 2)
+
+
+def _worst(cells: list[dict[str, Any]]) -> dict[str, Any] | None:
+    """The cell with the largest position error."""
+    if not cells:
+        return None
+    c = max(cells, key=lambda c: c["position_m"])
+    return {"route": c["route"], "map": c["map"], "position_m": c["position_m"]}
 
 
 def _map_spec(protocol: Protocol, route: Dataset) -> GridSpec | PosesSpec:
@@ -207,16 +273,90 @@ def _protocol_doc(protocol: Protocol) -> dict[str, Any]:
 
 
 def format_table4(doc: dict[str, Any]) -> str:
-    """Routes x maps: median position error (m) / rotation error (deg)."""
+    """Routes x maps: median position error (m) / rotation error (deg), the paper's cell beside each
+    of ours when the document has them (``paper``) with the columns' medians and ratios, then the
+    top-1 retrieval per cell and what was recorded."""
     maps = list(doc["maps"])
     night = doc["protocol"].get("night_lights", "all")
     lines = [f"House {doc['house']}, descriptor {doc['descriptor']}: median position (m) / rotation (deg) "
-             f"error, median of {doc['runs']} runs; night lights: {night}",
-             f"{'route / map':<14}" + "".join(f"{m:>18}" for m in maps)]
+             f"error, median of {doc['runs']} runs; night lights: {night}"]
+    paper = doc.get("paper")
+    if paper is None:
+        lines.append(f"{ROUTE_MAP:<14}" + "".join(f"{m:>18}" for m in maps))
+        lines += [f"{row[0]['route']:<14}" + "".join(f"{_pair(c):>18}" for c in row) for row in doc["cells"]]
+    else:
+        lines += _format_beside_paper(doc, paper)
+    lines += _format_retrieval(doc)
+    lines += _format_recordings(doc)
+    return "\n".join(line.rstrip() for line in lines)
+
+
+ROUTE_MAP = "route \\ map"
+W, L = 13, 24                              # characters per column, of the row names
+
+
+def _pair(cell: dict[str, Any] | None) -> str:
+    return "-" if cell is None else f"{cell['position_m']:.2f} / {cell['rotation_deg']:4.1f}"
+
+
+def _times(v: float | None) -> str:
+    return "-" if v is None else f"{v:.2f}x"
+
+
+def _metres(v: float | None) -> str:
+    return "-" if v is None else f"{v:.2f} m"
+
+
+def _format_beside_paper(doc: dict[str, Any], paper: dict[str, Any]) -> list[str]:
+    maps, columns = list(doc["maps"]), paper["columns"]
+    lines = [f"the paper's cell ({paper['method']}, {Path(paper['source']).name}) beside each of ours",
+             f"{ROUTE_MAP:<{L}}" + "".join(f"{m:^{2 * W}}" for m in maps),
+             f"{'':<{L}}" + f"{'ours':>{W}}{'paper':>{W}}" * len(maps)]
+    for ours_row, paper_row in zip(doc["cells"], paper["cells"]):
+        lines.append(f"{ours_row[0]['route']:<{L}}" + "".join(f"{_pair(o):>{W}}{_pair(p):>{W}}"
+                                                             for o, p in zip(ours_row, paper_row)))
+    lines.append(f"{'median of the column':<{L}}" + "".join(
+        f"{_metres(c['ours_median_m']):>{W}}{_metres(c['paper_median_m']):>{W}}" for c in columns))
+    lines.append(f"{'ratio to ' + maps[0] + ' column':<{L}}" + "".join(
+        f"{_times(c['ours_over_first_map']):>{W}}{_times(c['paper_over_first_map']):>{W}}" for c in columns))
+    lines.append(f"{'ours / paper':<{L}}" + "".join(f"{_times(c['ours_over_paper']):>{W}}{'':>{W}}" for c in columns))
+    short = [f"{c['map']}: {c['paper_routes']} of {len(doc['cells'])} routes" for c in columns
+             if c["paper_routes"] < len(doc["cells"])]
+    if short:
+        lines.append("the paper's column medians cover " + ", ".join(short))
+    worst = [f"{who} {w['route']} on {w['map']} ({w['position_m']:.2f} m)"
+             for who, w in paper["worst"].items() if w is not None]
+    lines.append("largest position error: " + "; ".join(worst))
+    return lines
+
+
+def _format_retrieval(doc: dict[str, Any]) -> list[str]:
+    if not all("top1_pct" in c for row in doc["cells"] for c in row):
+        return []
+    top1 = doc.get("top1", {"within_m": TOP1_M, "within_deg": TOP1_DEG})
+    lines = ["", f"top-1 retrieval, ours: % of route images whose most similar map image lies within "
+                 f"{top1['within_m']:g} m and {top1['within_deg']:g} deg (no odometry);",
+             "nearest: median distance from a route image to the nearest map image (the map's floor)",
+             f"{ROUTE_MAP:<{L}}" + "".join(f"{m:>{W}}" for m in doc["maps"]) + f"{'nearest':>{W}}"]
     for row in doc["cells"]:
-        lines.append(f"{row[0]['route']:<14}" + "".join(f"{c['position_m']:>10.2f} / {c['rotation_deg']:>5.1f}"
-                                                        for c in row))
-    return "\n".join(lines)
+        nearest = sorted({f"{c['nearest_map_image_m']:.2f}" for c in row}, key=float)
+        span = nearest[0] if len(nearest) == 1 else f"{nearest[0]}-{nearest[-1]}"
+        lines.append(f"{row[0]['route']:<{L}}" + "".join(f"{c['top1_pct']:>{W - 2}.1f} %" for c in row)
+                     + f"{span + ' m':>{W}}")
+    return lines
+
+
+def _format_recordings(doc: dict[str, Any]) -> list[str]:
+    maps = ", ".join(f"{m} {v['images']}" for m, v in doc["maps"].items())
+    routes = ", ".join(f"{r} {v['images']} ({v['length_m']:.1f} m)" for r, v in doc["routes"].items())
+    lines = ["", f"images: maps {maps}; routes {routes}"]
+    if doc.get("night_lights_on"):
+        lit = ", ".join(f"{k} {n}" for k, n in doc["night_lights_on"].items())
+        lines.append(f"lights on at night (of the house's {doc['house_lights']}): {lit}")
+    if "wall_s" in doc:
+        lines.append(f"wall time of this run: recording {doc['wall_s']['record']:.0f} s (recordings already "
+                     f"there are reused), describing and localizing {doc['wall_s']['evaluate']:.0f} s")
+    return lines
 
 
 # --------------------------------------------------------------------------- the heat map
