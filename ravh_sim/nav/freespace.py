@@ -74,17 +74,24 @@ def obstacles(house: House, door_open: Mapping[str, bool], models: Mapping[str, 
 
     The grid covers ``house.bounds`` plus ``margin`` on every side, aligned to ``resolution``.
     """
-    if resolution <= 0 or height <= 0 or margin < 0:
-        raise ValueError(f"need resolution > 0, height > 0, margin >= 0; got {resolution}, "
-                         f"{height}, {margin}")
-    open_state = door_states(house, door_open)
-    models = checked_models(house, models or {})
-    grid = floor_grid(house, open_state, resolution, margin)
+    open_state, models, grid = map_start(house, door_open, models, resolution, margin, height=height)
     blocked = np.zeros(grid.shape, np.uint8)
     for box in _obstacle_boxes(house, open_state, models, height, resolution):
         fill_box(blocked, box, grid)
     grid.data[blocked > 0] = OCCUPIED
     return grid
+
+
+def map_start(house: House, door_open: Mapping[str, bool], models: Mapping[str, int] | None, resolution: float,
+              margin: float, **heights: float) -> tuple[dict[str, bool], Mapping[str, int], Grid]:
+    """What every map of a house starts from: its arguments checked (``heights`` by name, each > 0), the
+    doors' states, the models, and the known floor (:func:`floor_grid`)."""
+    if resolution <= 0 or margin < 0 or any(h <= 0 for h in heights.values()):
+        named = ", ".join(f"{k} > 0" for k in heights)
+        raise ValueError(f"need resolution > 0, {named}, margin >= 0; got {resolution}, "
+                         f"{', '.join(map(str, heights.values()))}, {margin}")
+    open_state = door_states(house, door_open)
+    return open_state, checked_models(house, models or {}), floor_grid(house, open_state, resolution, margin)
 
 
 def floor_grid(house: House, open_state: Mapping[str, bool], resolution: float, margin: float) -> Grid:

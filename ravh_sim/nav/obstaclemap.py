@@ -28,7 +28,7 @@ from collections.abc import Mapping
 import cv2
 import numpy as np
 
-from ravh_sim.nav.freespace import SCALE, SHIFT, checked_models, door_states, fill_box, floor_grid, pixels, wall_box
+from ravh_sim.nav.freespace import SCALE, SHIFT, fill_box, map_start, pixels, wall_box
 from ravh_sim.nav.grid import OCCUPIED, Grid
 from ravh_sim.world.house import House
 from ravh_sim.world.solids import object_parts
@@ -42,12 +42,7 @@ def obstacle_map(house: House, door_open: Mapping[str, bool], models: Mapping[st
                  laser_height: float, resolution: float, margin: float = 0.5) -> Grid:
     """Known floor FREE, what the laser at ``laser_height`` above the floor hits OCCUPIED, outside
     UNKNOWN; doors and models as :func:`ravh_sim.nav.freespace.obstacles` takes them, on the same grid."""
-    if resolution <= 0 or laser_height <= 0 or margin < 0:
-        raise ValueError(f"need resolution > 0, laser_height > 0, margin >= 0; got {resolution}, "
-                         f"{laser_height}, {margin}")
-    open_state = door_states(house, door_open)
-    models = checked_models(house, models or {})
-    grid = floor_grid(house, open_state, resolution, margin)
+    open_state, models, grid = map_start(house, door_open, models, resolution, margin, laser_height=laser_height)
     hit = np.zeros(grid.shape, np.uint8)
     floor_z = {room.id: room.floor_z for room in house.rooms}
     for wall in (w for room in house.rooms for w in solid_walls(house, room.id)):
