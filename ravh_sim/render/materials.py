@@ -19,7 +19,7 @@ import numpy as np
 
 from ravh_sim.paths import FURNITURE_DIR
 from ravh_sim.world import paints
-from ravh_sim.world.library import LibraryMaterial
+from ravh_sim.world.library import LibraryMaterial, is_glass
 from ravh_sim.world.palette import PALETTE
 
 RGB = tuple[float, float, float]
@@ -163,11 +163,13 @@ _LIBRARY_FAMILY = {"wood": "wood", "fabric": "fabric", "leather": "leather", "me
 def library_material(material: LibraryMaterial, layer: int) -> Material:
     """A library model's MTL material: textured ones sample their texture (layer of the texture
     array); the others are the procedural material of their kind in their MTL colour. Furniture
-    glass is drawn as dark, glossy glass (there is no see-through)."""
+    glass (:func:`ravh_sim.world.library.is_glass`) is drawn as dark, glossy glass with nothing seen
+    through it: opaque in the depth and instance images, as it is to the laser (the library's one
+    decision about glass; clear panes are not in the library)."""
     colour = srgb_to_linear(material.colour)
     if material.kind == "textured":
         return Material((1.0, 1.0, 1.0), "textured", material.roughness, variation=0.0, bump=0.35, layer=layer)
-    if material.kind == "glass":
+    if is_glass(material):
         return Material(_scaled(colour, 0.3), "ceramic", 0.05, variation=0.0)
     family = palette_material(_LIBRARY_FAMILY[material.kind], material.colour)
     if material.kind == "metal":          # MTL greys of steel are dark; polished steel reflects ~60 %

@@ -30,7 +30,14 @@ import numpy as np
 import trimesh
 
 from ravh_sim.errors import UserError
-from ravh_sim.world.library import CATALOG_FORMAT, LibraryMaterial, material_kind, piece_labels
+from ravh_sim.world.library import (
+    CATALOG_FORMAT,
+    CLEAR_GLASS_OPACITY,
+    LibraryMaterial,
+    is_clear_glass,
+    material_kind,
+    piece_labels,
+)
 
 TRIANGLE_BUDGET = 1000
 """Triangles of a model 1.5 m or larger after simplification (smaller ones get a share in proportion
@@ -48,8 +55,9 @@ every match is over keeps its smallest."""
 TEXTURE_TEXELS = 256
 """Longest texture side: fabric, wood and labels tile or cover a few hundred pixels in a frame."""
 MAX_PER_TYPE = 4
-DROPPED_OPACITY = 0.35
-"""Materials at most this opaque (clear glass panes) are left out: no sensor of ours sees them."""
+DROPPED_OPACITY = CLEAR_GLASS_OPACITY
+"""Materials at most this opaque (clear glass panes) are left out: no sensor of ours sees them (the
+library's one decision about glass, :mod:`ravh_sim.world.library`)."""
 
 INDOOR = ("Bathroom", "Bedroom", "Kitchen", "Living room", "Office", "Lights", "Miscellaneous")
 
@@ -290,7 +298,7 @@ class Converted:
 def convert(entry: Entry, zf: zipfile.ZipFile) -> Converted:
     """Read, orient, scale, simplify and texture one catalogue model."""
     obj = read_obj(zf, entry.model)
-    keep_material = np.array([m["d"] > DROPPED_OPACITY for m in obj.materials], bool)
+    keep_material = np.array([not is_clear_glass(m["d"]) for m in obj.materials], bool)
     keep = keep_material[obj.face_material]
     faces, face_material = obj.faces[keep], obj.face_material[keep]
     vertices = obj.vertices

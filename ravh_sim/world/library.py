@@ -17,6 +17,21 @@ proportions allow, its width and depth within :data:`MAX_STRETCH` of that scale,
 floor and against its back; so it always lies inside the box the footprint records. An object's
 model variants are its kind's models in order of how well they fit its box (:func:`misfit`), so
 the default variant is the best-proportioned one.
+
+Glass, decided here once for every sensor:
+
+- Clear glass (an MTL material at most :data:`CLEAR_GLASS_OPACITY` opaque: shower screens, clear
+  cabinet panes) is transparent to every sensor: the importer leaves its triangles out of the
+  library, so neither the laser's collider, nor the depth, instance or colour image has it. The
+  camera and the laser both see what stands behind it (as real lidars and depth cameras mostly do).
+- Every other glass (:func:`is_glass`: tinted, smoked or frosted glass up to :data:`GLASS_OPACITY`,
+  and materials named glass: table tops, oven, microwave and cabinet doors, lamp shades) is opaque
+  to every sensor, like any other surface: the laser collides with it (every triangle of a model is
+  in its collider, ``World._model_collision``), the renderer draws it into the depth and instance
+  images (dark, glossy, with nothing seen through it: :func:`ravh_sim.render.materials.library_material`).
+
+So the laser and the depth image never disagree about glass: both read :attr:`LibraryModel.faces`,
+glass faces included, and nothing else.
 """
 from __future__ import annotations
 
@@ -40,6 +55,11 @@ MAX_STRETCH = 1.3
 a bench."""
 
 _TEXTURE_STAND_IN = (0.6, 0.5, 0.4)          # a textured material's colour where textures are not drawn
+CLEAR_GLASS_OPACITY = 0.35
+"""MTL opacity (``d``) at or below which a material is clear glass: transparent to every sensor,
+left out of the library at import (:mod:`ravh_sim.world.furniture_import`)."""
+GLASS_OPACITY = 0.9
+"""MTL opacity below which a kept material is glass (tinted, smoked, frosted): opaque to every sensor."""
 
 Kind = Literal["textured", "wood", "fabric", "leather", "metal", "glass", "mirror", "screen", "ceramic",
                "marble", "plant", "emissive", "plain"]
@@ -59,12 +79,17 @@ _KIND_WORDS: tuple[tuple[Kind, str], ...] = (
 )
 
 
+def is_clear_glass(opacity: float) -> bool:
+    """Whether an MTL material of this opacity is clear glass, which no sensor sees (see Glass above)."""
+    return opacity <= CLEAR_GLASS_OPACITY
+
+
 def material_kind(name: str, textured: bool, opacity: float) -> Kind:
     """What an MTL material is made of, from its name (textured ones keep their texture)."""
     if textured:
         return "textured"
     lowered = name.lower()
-    if opacity < 0.9:
+    if opacity < GLASS_OPACITY:
         return "glass"
     for kind, pattern in _KIND_WORDS:
         if re.search(pattern, lowered):
@@ -79,6 +104,11 @@ class LibraryMaterial(Strict):
     texture: str | None = None
     roughness: float = Field(ge=0.0, le=1.0)
     kind: Kind
+
+
+def is_glass(material: LibraryMaterial) -> bool:
+    """Whether a library material is glass: opaque to every sensor, drawn as glass (see Glass above)."""
+    return material.kind == "glass"
 
 
 class LibraryRecord(Strict):
@@ -117,6 +147,13 @@ class LibraryModel:
     def materials(self) -> list[LibraryMaterial]:
         return self.record.materials
 
+    @property
+    def glass_faces(self) -> np.ndarray:
+        """(M,) bool: the faces of glass materials (:func:`is_glass`), which collide and are drawn
+        like every other face."""
+        glass = np.array([is_glass(m) for m in self.materials], bool)
+        return glass[self.face_material] if len(glass) else np.zeros(len(self.faces), bool)
+
 
 @dataclass(frozen=True)
 class FittedModel:
@@ -126,6 +163,8 @@ class FittedModel:
 
     @property
     def mesh(self) -> trimesh.Trimesh:
+        """Every triangle of the model, glass included: what the laser collides with and what the
+        camera draws."""
         return trimesh.Trimesh(self.vertices, self.model.faces, process=False)
 
 

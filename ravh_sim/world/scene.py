@@ -48,6 +48,12 @@ OPEN_DOOR_DROP = 50.0                          # m an open door's leaf sinks, ou
 OWN_GROUP_BITS = range(8, 31)                  # collision group bits for bodies hidden from rays (the
                                                # lower ones are Bullet's default, static, ... groups)
 ALL_GROUPS = -1
+COMPOUND_LIMIT = 16
+"""Shapes pybullet keeps of one ``createCollisionShapeArray`` call (its MAX_COMPOUND_COLLISION_SHAPES):
+it drops every one beyond without a word, so a room's wall pieces go into compounds of at most this
+many, the first on the walls body's base and the others on fixed links of it (a corridor of 26
+pieces had lost 10, walls among them: the laser and the robot passed through walls the camera
+drew)."""
 CEILING_PAINT = "white"
 GROUND_HALF_SIZE = 60.0
 
@@ -185,23 +191,27 @@ class World:
             body = self._mesh_body(wall_mesh(walls, self.house.windows), self._wall_collision(walls), "walls")
             self._apply_paint(body, self.state.paint[room.id]["walls"])
         elif inst.kind == "floor":
-            body = self._mesh_body(floor_mesh(room, room.floor_z), -1, "floor")
+            body = self._mesh_body(floor_mesh(room, room.floor_z), [-1], "floor")
             self._apply_paint(body, self.state.paint[room.id]["floor"])
         else:
-            body = self._mesh_body(floor_mesh(room, room.ceiling_z, facing_up=False), -1, "ceiling")
+            body = self._mesh_body(floor_mesh(room, room.ceiling_z, facing_up=False), [-1], "ceiling")
             self._apply_paint(body, CEILING_PAINT)
         return body
 
-    def _wall_collision(self, walls: list[Wall]) -> int:
-        half, pos, orn = [], [], []
-        for w in walls:
-            (ax, ay), (bx, by) = w.a, w.b
-            half.append([max(w.length, 0.01) / 2, w.thickness / 2, (w.z1 - w.z0) / 2])
-            pos.append([(ax + bx) / 2, (ay + by) / 2, (w.z0 + w.z1) / 2])
-            orn.append(quaternion_from_yaw(math.atan2(by - ay, bx - ax)))
-        return pb.createCollisionShapeArray([pb.GEOM_BOX] * len(walls), halfExtents=half,
-                                            collisionFramePositions=pos,
-                                            collisionFrameOrientations=orn, physicsClientId=self.client)
+    def _wall_collision(self, walls: list[Wall]) -> list[int]:
+        """The wall pieces as boxes, in compounds of at most COMPOUND_LIMIT (one body's base and links)."""
+        compounds = []
+        for first in range(0, len(walls), COMPOUND_LIMIT):
+            half, pos, orn = [], [], []
+            for w in walls[first:first + COMPOUND_LIMIT]:
+                (ax, ay), (bx, by) = w.a, w.b
+                half.append([max(w.length, 0.01) / 2, w.thickness / 2, (w.z1 - w.z0) / 2])
+                pos.append([(ax + bx) / 2, (ay + by) / 2, (w.z0 + w.z1) / 2])
+                orn.append(quaternion_from_yaw(math.atan2(by - ay, bx - ax)))
+            compounds.append(pb.createCollisionShapeArray([pb.GEOM_BOX] * len(half), halfExtents=half,
+                                                          collisionFramePositions=pos,
+                                                          collisionFrameOrientations=orn, physicsClientId=self.client))
+        return compounds
 
     def _object_body(self, obj: HouseObject, model: int) -> int:
         """The object's model, colliding part by part (see :mod:`ravh_sim.world.solids`); a door is
@@ -231,7 +241,8 @@ class World:
 
     def _model_collision(self, fitted: FittedModel) -> int:
         """A library model collides as its own triangles (a static concave mesh: exact for the laser,
-        which then sees what the camera draws), loaded from a cached OBJ file."""
+        which then sees what the camera draws), every one of them, glass included (glass is opaque
+        to every sensor, :mod:`ravh_sim.world.library`), loaded from a cached OBJ file."""
         mesh = fitted.mesh
         key = fitted.model.id.encode() + np.round(fitted.vertices, 5).tobytes()
         path = self._asset(key, ".obj", lambda p: mesh.export(p, file_type="obj", include_normals=False,
@@ -245,24 +256,37 @@ class World:
         path = self._asset(text.encode(), ".obj", lambda p: p.write_text(text))
         return pb.createCollisionShape(pb.GEOM_MESH, fileName=str(path), physicsClientId=self.client)
 
-    def _mesh_body(self, mesh: TexturedMesh, collision: int, surface: str) -> int:
+    def _mesh_body(self, mesh: TexturedMesh, collisions: list[int], surface: str) -> int:
+        """A piece of structure drawn as ``mesh``, colliding as ``collisions`` (the base's shape, then
+        one per fixed link; ``[-1]``: none)."""
         path = None
         if self._pybullet_draws:
             key = np.concatenate([mesh.vertices.ravel(), mesh.uvs.ravel()]).round(4).tobytes()
             path = self._asset(key, ".obj", mesh.write_obj)
         self.triangle_count += mesh.triangle_count
-        body = self._new_body(collision, (0, 0, 0), 0.0, path)
+        body = self._new_body(collisions[0], (0, 0, 0), 0.0, path, links=collisions[1:])
         self.visuals[body] = Visual(structure=mesh, surface=surface)
         return body
 
-    def _new_body(self, collision: int, position, yaw: float, visual_file: Path | None = None) -> int:
+    def _new_body(self, collision: int, position, yaw: float, visual_file: Path | None = None,
+                  links: list[int] | None = None) -> int:
         """A static body; with a visual shape from ``visual_file`` only where pybullet draws (the
         TinyRenderer): our GL renderer draws from :attr:`visuals`, and pybullet's parse of every
-        model's OBJ would only cost build time."""
+        model's OBJ would only cost build time. ``links``: more collision shapes, each on a link
+        fixed to the base at its origin (rays and contacts report the body, so it stays one
+        instance)."""
         visual = -1 if visual_file is None else pb.createVisualShape(pb.GEOM_MESH, fileName=str(visual_file),
                                                                     physicsClientId=self.client)
+        n = len(links or ())
+        origin, identity = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]
         return pb.createMultiBody(0, collision, visual, basePosition=list(position),
-                                  baseOrientation=quaternion_from_yaw(yaw), physicsClientId=self.client)
+                                  baseOrientation=quaternion_from_yaw(yaw), linkMasses=[0.0] * n,
+                                  linkCollisionShapeIndices=list(links or ()), linkVisualShapeIndices=[-1] * n,
+                                  linkPositions=[origin] * n, linkOrientations=[identity] * n,
+                                  linkInertialFramePositions=[origin] * n,
+                                  linkInertialFrameOrientations=[identity] * n, linkParentIndices=[0] * n,
+                                  linkJointTypes=[pb.JOINT_FIXED] * n, linkJointAxis=[[0.0, 0.0, 1.0]] * n,
+                                  physicsClientId=self.client)
 
     def _asset(self, key: bytes, suffix: str, write) -> Path:
         """A content-addressed file in the asset cache, written atomically if missing."""
