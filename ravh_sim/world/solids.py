@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import trimesh
+from shapely.geometry import MultiPoint, Polygon
 
 from ravh_sim.world import library
 from ravh_sim.world.facing import choose_facing, front_axis, suits_box
@@ -120,22 +121,11 @@ def _hull_section(vertices: np.ndarray, z: float) -> np.ndarray:
 
 
 def _convex_hull(points: np.ndarray) -> np.ndarray:
-    """(k, 2) corners of the convex hull of (n, 2) points, counter-clockwise (Andrew's monotone chain;
-    collinear points dropped, so a flat set gives its two ends and a single point itself)."""
-    unique = np.unique(points, axis=0)                       # sorted by x, then y
-    if len(unique) < 3:
-        return unique
-
-    def chain(ordered: np.ndarray) -> list[np.ndarray]:
-        kept: list[np.ndarray] = []
-        for p in ordered:
-            while len(kept) >= 2 and ((kept[-1][0] - kept[-2][0]) * (p[1] - kept[-2][1])
-                                      - (kept[-1][1] - kept[-2][1]) * (p[0] - kept[-2][0])) <= 0:
-                kept.pop()
-            kept.append(p)
-        return kept[:-1]
-
-    return np.array(chain(unique) + chain(unique[::-1]))
+    """(k, 2) corners of the convex hull of (n, 2) points (shapely; collinear points dropped, so a flat
+    set gives its two ends and a single point itself)."""
+    hull = MultiPoint(points).convex_hull
+    corners = np.asarray(hull.exterior.coords if isinstance(hull, Polygon) else hull.coords, np.float64)
+    return corners[:-1] if isinstance(hull, Polygon) else corners
 
 
 def _model_section(fitted: library.FittedModel, z: float) -> np.ndarray:
