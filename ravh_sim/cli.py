@@ -76,14 +76,14 @@ def _print_json(data: object) -> None:
 # ---------------------------------------------------------------------------- houses (issue: houses)
 
 def cmd_import_houses(args: argparse.Namespace) -> int:
-    from ravh_sim.world.importer import import_houses
+    from ravh_sim.importers.houses import import_houses
     written = import_houses(args.src, args.out)
     print(f"imported {len(written)} houses into {args.out}")
     return 0
 
 
 def cmd_import_furniture(args: argparse.Namespace) -> int:
-    from ravh_sim.world.furniture_import import import_furniture, iter_archives
+    from ravh_sim.importers.furniture import import_furniture, iter_archives
     archives = list(iter_archives(args.src))
     if not archives:
         raise UserError("no .sh3f or .jar furniture catalogue among " + ", ".join(map(str, args.src)))

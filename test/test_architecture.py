@@ -128,7 +128,8 @@ LAYERS: list[tuple[str, ...]] = [
     ("ravh_msgs_py", "ravh_sim", "ravh_sim.errors", "ravh_sim.paths", "ravh_sim.files", "ravh_sim.poses",
      "ravh_sim.schema", "ravh_sim.paper"),
     ("ravh_sim.world",),                         # the house and its physics, told which backend draws it
-    ("ravh_sim.render",),                        # draws the world; whoever builds both resolves the backend here
+    ("ravh_sim.look",),                          # what the camera should see: geometry, materials, lights
+    ("ravh_sim.render",),                        # draws the scene description; whoever builds both resolves the backend
     ("ravh_sim.sensors",),                       # each declares its profile section, files and topics
     ("ravh_sim.nav",),                           # maps and paths; reads a robot's size and limits via Protocols
     ("ravh_sim.robot",),                         # a profile's body in the physics; agents start on nav's free space
@@ -139,6 +140,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("ravh_sim.nodes",),
     ("ravh_sim.raids",),                         # recording datasets: ROS processes or one direct process
     ("ravh_sim.eval",),                          # the paper's experiments, over recorded datasets
+    ("ravh_sim.importers",),                     # offline converters to houses and the library; no runtime use
     ("ravh_sim.bench", "ravh_sim.bench_ros", "ravh_sim.cli"),
 ]
 

@@ -8,9 +8,9 @@ import pytest
 from conftest import UPSTREAM
 
 from ravh_sim.errors import FileFieldError, UnknownNameError
+from ravh_sim.importers.houses import convert_house, dump_house, import_houses
 from ravh_sim.paths import HOUSES_DIR
 from ravh_sim.world.house import HOUSE_FORMAT, house_from_dict, load_house
-from ravh_sim.world.importer import convert_house, dump_house, import_houses
 
 NOT_IN_FLOOR = {"Door", "Wall"}            # doors and windows sit inside the walls
 

@@ -11,10 +11,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from ravh_sim.paths import FURNITURE_DIR
-from ravh_sim.world import library
-from ravh_sim.world.furniture import OBJECT_TYPES
-from ravh_sim.world.furniture_import import (
+from ravh_sim.importers.furniture import (
     ABSOLUTE_BUDGET,
     MIN_TRIANGLES,
     OVER_BUDGET,
@@ -25,6 +22,9 @@ from ravh_sim.world.furniture_import import (
     import_furniture,
     read_properties,
 )
+from ravh_sim.paths import FURNITURE_DIR
+from ravh_sim.world import library
+from ravh_sim.world.furniture import OBJECT_TYPES
 from ravh_sim.world.library import LibraryCatalog, kind_of, models_of
 from ravh_sim.world.solids import model_count, object_parts
 
@@ -137,7 +137,7 @@ def test_import_furniture_command_writes_the_library(tmp_path, capsys):
 
 
 def test_importer_simplifies_to_the_budget(tmp_path, monkeypatch):
-    import ravh_sim.world.furniture_import as importer
+    import ravh_sim.importers.furniture as importer
     monkeypatch.setattr(importer, "TRIANGLE_BUDGET", 40)
     monkeypatch.setattr(importer, "MIN_TRIANGLES", 40)
     sphere = __import__("trimesh").creation.icosphere(3)                # 1280 triangles

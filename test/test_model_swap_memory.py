@@ -141,8 +141,8 @@ def test_the_gl_scene_builder_keeps_only_models_the_world_shows(world, appearanc
     """Every model an object has shown is remembered here, by (object, model index); after each swap the
     builder keeps the arrays of none of those the state no longer shows (worked out from the state, not
     from the World's visuals, which the builder itself reads)."""
-    from ravh_sim.render.geometry import SceneBuilder
-    from ravh_sim.render.materials import MaterialTable
+    from ravh_sim.look.geometry import SceneBuilder
+    from ravh_sim.look.materials import MaterialTable
     builder = SceneBuilder(world, MaterialTable())
     sources: dict[tuple[str, int], int] = {}                  # (object, model) -> id of what draws it
     objects = [inst for inst in world.instances if inst.kind == "object"]

@@ -30,9 +30,9 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
+from ravh_sim.look.geometry import ATTRIBUTES, VERTEX_FORMAT, SceneBuilder
+from ravh_sim.look.materials import NOISE_TEXELS, PATTERN, TEXELS, MaterialTable, noise_volume, srgb8_to_linear
 from ravh_sim.render.backend import gl_context, unlocked_gl
-from ravh_sim.render.geometry import ATTRIBUTES, VERTEX_FORMAT, SceneBuilder
-from ravh_sim.render.materials import NOISE_TEXELS, PATTERN, TEXELS, MaterialTable, noise_volume, srgb8_to_linear
 from ravh_sim.render.projection import look_at, orthographic, perspective, projection_from_K, view_matrix
 from ravh_sim.render.views import Development, Exposure, RenderedViews, typical_depth
 from ravh_sim.world.appearance import SunLight, lamps_at, sun_light

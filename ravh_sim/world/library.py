@@ -1,6 +1,6 @@
 """The furniture library: modelled furniture from open catalogues, fitted into the houses' boxes.
 
-Format (``furniture/``, written by ``ravh import-furniture``, :mod:`ravh_sim.world.furniture_import`):
+Format (``furniture/``, written by ``ravh import-furniture``, :mod:`ravh_sim.importers.furniture`):
 
 - ``catalog.json``: ``{"format": CATALOG_FORMAT, "models": [...]}``; each model names its ``kind``
   (our object type, or ``Type/class`` where a prefab class looks different: office chairs, coffee
@@ -28,7 +28,7 @@ Glass, decided here once for every sensor:
   and materials named glass: table tops, oven, microwave and cabinet doors, lamp shades) is opaque
   to every sensor, like any other surface: the laser collides with it (every triangle of a model is
   in its collider, ``World._model_collision``), the renderer draws it into the depth and instance
-  images (dark, glossy, with nothing seen through it: :func:`ravh_sim.render.materials.library_material`).
+  images (dark, glossy, with nothing seen through it: :func:`ravh_sim.look.materials.library_material`).
 
 So the laser and the depth image never disagree about glass: both read :attr:`LibraryModel.faces`,
 glass faces included, and nothing else.
@@ -57,7 +57,7 @@ a bench."""
 _TEXTURE_STAND_IN = (0.6, 0.5, 0.4)          # a textured material's colour where textures are not drawn
 CLEAR_GLASS_OPACITY = 0.35
 """MTL opacity (``d``) at or below which a material is clear glass: transparent to every sensor,
-left out of the library at import (:mod:`ravh_sim.world.furniture_import`)."""
+left out of the library at import (:mod:`ravh_sim.importers.furniture`)."""
 GLASS_OPACITY = 0.9
 """MTL opacity below which a kept material is glass (tinted, smoked, frosted): opaque to every sensor."""
 

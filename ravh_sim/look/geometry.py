@@ -2,7 +2,7 @@
 
 Every triangle corner carries its house-frame position, a shading normal, its position in the body's
 own frame (procedural patterns are evaluated there, so a wood grain moves with its table and does
-not swim when a door swings), a material index (ravh_sim.render.materials), the instance id that
+not swim when a door swings), a material index (ravh_sim.look.materials), the instance id that
 instance images store and a texture coordinate (library models' textures; zero elsewhere). Normals
 come from trimesh: smooth across gentle bends (cushions, bowls, lamp shades), flat across creases
 (box edges), decided per corner by a crease angle.
@@ -15,8 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 
+from ravh_sim.look.materials import MaterialTable
 from ravh_sim.poses import pose_matrix
-from ravh_sim.render.materials import MaterialTable
 from ravh_sim.world.library import FittedModel
 from ravh_sim.world.mesh import Mesh
 from ravh_sim.world.scene import Visual, World
