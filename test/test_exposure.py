@@ -17,7 +17,8 @@ from test_sensors import PROFILE
 from ravh_sim.nav.grid import FREE
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.render.backend import resolve_backend
-from ravh_sim.render.gl_renderer import GLRenderer, RenderError
+from ravh_sim.render.gl_develop import RenderError
+from ravh_sim.render.gl_renderer import GLRenderer
 from ravh_sim.sensors.camera import SmartCamera
 from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.house import load_house
@@ -92,12 +93,12 @@ def test_a_nan_pixel_neither_meters_nor_is_stored(black_view_world):
     renderer = camera.renderer
     assert isinstance(renderer, GLRenderer)
     clean = camera.render(*WAS_BLACK[1]).rgb
-    exposure = renderer._exposure(renderer._meter_blocks())
+    exposure = renderer.developer.auto_exposure(renderer.developer.meter_blocks())
     hdr = np.frombuffer(renderer.hdr.read(), np.float16).reshape(renderer.height, renderer.width, 4).copy()
     hdr[100, 200] = np.nan
     renderer.hdr.write(hdr.tobytes())
     with pytest.raises(RenderError, match="1 pixels of non-finite radiance"):
-        renderer._develop(None)
-    assert math.isfinite(renderer._exposure(renderer._meter_blocks()))
-    assert renderer._exposure(renderer._meter_blocks()) == pytest.approx(exposure, rel=0.01)
+        renderer.developer.develop(None)
+    assert math.isfinite(renderer.developer.auto_exposure(renderer.developer.meter_blocks()))
+    assert renderer.developer.auto_exposure(renderer.developer.meter_blocks()) == pytest.approx(exposure, rel=0.01)
     assert clean.mean() > MEAN_LUMA[0]

@@ -13,8 +13,9 @@ from test_sensors import PROFILE, _box_house, _world
 from ravh_msgs_py.appearance import parse
 from ravh_msgs_py.query import QueryError
 from ravh_sim.errors import FileFieldError
+from ravh_sim.look.lighting import HOUSE_KELVIN, lamps_at
 from ravh_sim.sensors.camera import CameraOptions, SmartCamera
-from ravh_sim.world.appearance import HOUSE_KELVIN, Appearance, lamps_at
+from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.settings import Resolved, load_settings, resolve
 

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 from test_sensors import PROFILE, gl_box_world, restored_appearance
 
+from ravh_sim.look.lighting import sun_light
 from ravh_sim.look.materials import noise_volume
 from ravh_sim.sensors.camera import CameraOptions, SmartCamera
-from ravh_sim.world.appearance import sun_light
 
 EXPOSURE = CameraOptions(manual_exposure=1.0)
 

@@ -52,7 +52,7 @@ def develop(renderer: GLRenderer, radiance: np.ndarray, sensor: SensorModel, see
     renderer.hdr.write(np.ascontiguousarray(hdr, np.float16).tobytes())
     renderer.depth.write(np.full((H, W), DEPTH_M, np.float32).tobytes())
     renderer.instance.write(np.ones((H, W), np.int32).tobytes())
-    views = renderer._develop(None, development=Development(sensor, np.random.default_rng(seed), velocity))
+    views = renderer.developer.develop(None, development=Development(sensor, np.random.default_rng(seed), velocity))
     assert views.exposure is not None
     return views.rgb, views.exposure
 

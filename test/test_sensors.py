@@ -18,6 +18,7 @@ import pytest
 from ravh_msgs_py import names
 from ravh_sim.cli import main
 from ravh_sim.errors import UserError
+from ravh_sim.look.lighting import sun_light
 from ravh_sim.nav.follower import PathFollower, Status
 from ravh_sim.nav.navigation import Navigation
 from ravh_sim.nav.planner import Unreachable
@@ -30,7 +31,7 @@ from ravh_sim.sensors.camera import CameraOptions, SmartCamera
 from ravh_sim.sensors.imaging import encode_jpeg, jpeg_roundtrip
 from ravh_sim.sensors.laser import Laser
 from ravh_sim.sensors.mount import LINK_TO_OPTICAL
-from ravh_sim.world.appearance import Appearance, sun_light
+from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import make_footprint
 from ravh_sim.world.house import HOUSE_FORMAT, house_from_dict
 from ravh_sim.world.scene import World
@@ -392,7 +393,7 @@ def drawn_hits(placed, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
     v = placed.model.vertices
     xyz = np.column_stack([placed.position[0] + c * v[:, 0] - s * v[:, 1],
                            placed.position[1] + s * v[:, 0] + c * v[:, 1], placed.position[2] + v[:, 2]])
-    a, b, c_ = (xyz[placed.model.model.faces[:, k]] for k in range(3))
+    a, b, c_ = (xyz[placed.model.faces[:, k]] for k in range(3))
     e1, e2 = b - a, c_ - a
     out = np.full(len(starts), np.inf)
     for i, (p, q) in enumerate(zip(starts, ends)):

@@ -22,7 +22,7 @@ from std_srvs.srv import Trigger
 from ravh_msgs_py import names as n
 from ravh_msgs_py.capture import CaptureEvent
 from ravh_sim.nodes import convert
-from ravh_sim.render.gl_renderer import RenderError
+from ravh_sim.render.gl_develop import RenderError
 from ravh_sim.render.views import RenderedViews
 from ravh_sim.sensors import imaging
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from ravh_sim.world.appearance import SunLight
+from ravh_sim.look.lighting import SunLight
 from ravh_sim.world.house import Light
 from ravh_sim.world.scene import World
 

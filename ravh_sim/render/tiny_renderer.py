@@ -2,8 +2,9 @@
 
 pybullet draws the World's bodies with one directional light (the sun's direction) and fixed shading;
 :mod:`tiny_lighting` then adds daylight colour and the switched-on lamps per room, and the sky fills
-the background. TinyRenderer samples pixel corners and flips rows one pixel off, so its projection
-is built from K with that sample offset and its pixels still match K exactly.
+the background; what shines is the scene's light model's (:func:`ravh_sim.look.lighting.scene_lights`).
+TinyRenderer samples pixel corners and flips rows one pixel off, so its projection is built from K with
+that sample offset and its pixels still match K exactly.
 """
 from __future__ import annotations
 
@@ -11,10 +12,10 @@ import cv2
 import numpy as np
 import pybullet as pb
 
+from ravh_sim.look.lighting import scene_lights
 from ravh_sim.render.projection import projection_from_K, view_matrix
 from ravh_sim.render.tiny_lighting import SUN_AMBIENT, SUN_DIFFUSE, Lighting
 from ravh_sim.render.views import Development, RenderedViews
-from ravh_sim.world.appearance import lamps_at, sun_light
 from ravh_sim.world.scene import World
 
 SAMPLE_OFFSET = (0.0, 1.0)        # where TinyRenderer samples pixel (u, v), measured against K
@@ -35,8 +36,8 @@ class TinyRenderer:
         """Views from an optical pose; ``exposure`` is ignored (the lighting pass sets the level), and
         so are ``radiance`` and ``development`` (no linear light: the camera develops the 8-bit image
         through its sensor model)."""
-        state = self.world.state
-        sun = sun_light(state.sun_angle)
+        scene = scene_lights(self.world.house, self.world.state)
+        sun = scene.sun
         view = view_matrix(position, rotation)
         _, _, rgba, buffer, seg = pb.getCameraImage(
             self.width, self.height, view.T.ravel().tolist(), self._projection,
@@ -51,10 +52,8 @@ class TinyRenderer:
         depth[background | (buffer >= 1.0)] = np.nan
         lut = np.append(self.world.body_to_instance_lut(), 0).astype(np.uint16)  # seg -1 -> last entry
         instance = np.take(lut, seg, mode="wrap")
-        lights = lamps_at([lt for lt in self.world.house.lights if state.lights.get(lt.id, False)],
-                          state.settings().light_temperature)
         rgb = self.lighting.apply(cv2.cvtColor(rgba, cv2.COLOR_RGBA2RGB), depth, instance, rotation,
-                                  position, sun, lights)
+                                  position, sun, list(scene.lamps))
         if background.any():
             rgb[background] = sun.sky
         return RenderedViews(rgb, depth, instance, background)

@@ -8,10 +8,7 @@ doors change pybullet bodies (through the World's primitives, no rebuild); the g
 angle, :data:`ravh_msgs_py.appearance.KNOBS`) and the lights are read by the camera at capture time, so
 switching them costs nothing. Random choices go through
 :func:`settings.resolve`, so "random" here picks exactly what the same seed picks in a settings file.
-
-The sun model (:func:`sun_light`) is here too: one angle gives the light direction, the colour and
-level of daylight indoors and the sky colour seen beyond the house and through the windows; and the
-lamp model (:func:`lamps_at`): the lights' colours at a colour temperature.
+What the knobs mean for the light is the scene's light model's (:mod:`ravh_sim.look.lighting`).
 
 A change that fails half-way is put back (:meth:`Appearance.apply`); should putting back fail too,
 the world is neither as it was nor as asked, and that is never silent: :class:`RollbackError` names
@@ -21,87 +18,20 @@ from __future__ import annotations
 
 import copy
 import logging
-import math
-from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, replace
+from collections.abc import Callable, Mapping
 from functools import lru_cache
 from typing import Any
 
-from ravh_msgs_py.appearance import KNOBS, LIGHT_GROUPS, SURFACES, SWITCH, Looks
+from ravh_msgs_py.appearance import KNOBS, LIGHT_GROUPS, SURFACES, SWITCH
 from ravh_msgs_py.query import UNKNOWN_ID, QueryError
 from ravh_sim.errors import UnknownNameError, UserError
 from ravh_sim.world import paints
-from ravh_sim.world.house import Light
 from ravh_sim.world.scene import World
 from ravh_sim.world.settings import Resolved, fit_model, knob_value, light_group, load_settings, resolve
 from ravh_sim.world.solids import model_count
 
 RGB = tuple[float, float, float]
 log = logging.getLogger(__name__)
-
-# Daylight indoors (multiplies pybullet's render) and sky colours, from night to noon.
-NIGHT_LEVEL = 0.12
-NIGHT_COLOUR: RGB = (0.45, 0.55, 1.0)
-HORIZON_COLOUR: RGB = (1.0, 0.62, 0.36)
-HORIZON_LEVEL = 0.6
-NOON_COLOUR: RGB = (1.0, 1.0, 1.0)
-SKY_NOON: RGB = (125, 178, 235)
-SKY_HORIZON: RGB = (240, 150, 95)
-SKY_NIGHT: RGB = (10, 14, 32)
-TWILIGHT_DEG = 15.0                       # how long after sunset (and before sunrise) light fades out
-SUN_SOUTH_TILT = 0.35                     # the sun's arc leans to -y so noon light is not vertical
-MOON_DIRECTION: RGB = (-0.3, 0.4, 0.87)
-HOUSE_KELVIN: float = Looks.model_fields["light_temperature"].default   # of the house files' light colours
-
-
-@dataclass(frozen=True)
-class SunLight:
-    """What one sun angle means for the camera."""
-    angle: float                          # degrees: 0 sunrise, 90 noon, 180 sunset, >180 night
-    direction: RGB                        # unit vector towards the sun (the moon at night), house frame
-    gain: RGB                             # daylight colour x level, multiplies the rendered image
-    sky: tuple[int, int, int]             # 8-bit RGB of the sky
-
-
-def sun_light(angle: float) -> SunLight:
-    """The sun at ``angle`` degrees: rises in +x (east), culminates over -y (south), sets in -x."""
-    a = angle % 360.0
-    rad = math.radians(a)
-    if a <= 180.0:
-        height = math.sqrt(max(math.sin(rad), 0.0))          # 0 at the horizon, 1 at noon
-        daylight = 1.0
-        direction = _unit((math.cos(rad), -SUN_SOUTH_TILT * math.sin(rad), math.sin(rad)))
-    else:
-        height = 0.0
-        below = min(a - 180.0, 360.0 - a)                      # degrees below the horizon
-        daylight = max(0.0, 1.0 - below / TWILIGHT_DEG)
-        direction = _unit(MOON_DIRECTION)
-    day_colour = _lerp(HORIZON_COLOUR, NOON_COLOUR, height)
-    day_level = HORIZON_LEVEL + (1.0 - HORIZON_LEVEL) * height
-    night = tuple(NIGHT_LEVEL * c for c in NIGHT_COLOUR)
-    gain = _lerp(night, tuple(day_level * c for c in day_colour), daylight)
-    sky = _lerp(SKY_NIGHT, _lerp(SKY_HORIZON, SKY_NOON, height), daylight)
-    red, green, blue = (int(round(c)) for c in sky)
-    return SunLight(a, direction, gain, (red, green, blue))
-
-
-def lamps_at(lights: Iterable[Light], kelvin: float) -> list[Light]:
-    """``lights`` at colour temperature ``kelvin``: each colour channel scales as a black body's does
-    from HOUSE_KELVIN to ``kelvin``, so at HOUSE_KELVIN every colour stays exactly as the house gives it."""
-    shift = tuple(a / b for a, b in zip(black_body(kelvin), black_body(HOUSE_KELVIN)))
-    return [replace(lt, color=(lt.color[0] * shift[0], lt.color[1] * shift[1], lt.color[2] * shift[2]))
-            for lt in lights]
-
-
-def black_body(kelvin: float) -> RGB:
-    """Linear-ish RGB (0..1) of a black body at ``kelvin`` (Tanner Helland's fit, 1000 K to 40000 K)."""
-    t = kelvin / 100.0
-    red = 255.0 if t <= 66 else 329.698727446 * (t - 60) ** -0.1332047592
-    green = 99.4708025861 * math.log(t) - 161.1195681661 if t <= 66 else 288.1221695283 * (t - 60) ** -0.0755148492
-    blue = 255.0 if t >= 66 else 0.0 if t <= 19 else 138.5177312231 * math.log(t - 10) - 305.0447927307
-    red, green, blue = (min(max(c, 0.0), 255.0) / 255.0 for c in (red, green, blue))
-    return (red, green, blue)
-
 
 class RollbackError(RuntimeError):
     """A change failed half-way and putting back what it had changed failed too: the world is neither as
@@ -124,10 +54,6 @@ class Appearance:
         self.state = world.state
 
     # ------------------------------------------------------------------ global knobs and lights
-    @property
-    def sun(self) -> SunLight:
-        return sun_light(self.state.sun_angle)
-
     def set_knob(self, name: str, choice: float | str, seed: int | None = None) -> None:
         """Set a global knob (KNOBS: "sun_angle", ...) to a number in its range or one of its words
         ("night"; "random" draws with ``seed``, by default the world's)."""
@@ -363,11 +289,3 @@ def _cached_defaults() -> dict[str, Any]:
 def _default_settings() -> dict[str, Any]:
     return copy.deepcopy(_cached_defaults())
 
-
-def _lerp(a, b, t: float) -> RGB:
-    return tuple(x + (y - x) * t for x, y in zip(a, b))
-
-
-def _unit(v) -> RGB:
-    n = math.sqrt(sum(c * c for c in v))
-    return tuple(c / n for c in v)
