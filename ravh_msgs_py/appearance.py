@@ -102,6 +102,8 @@ class Looks(BaseModel):
     models: Items[Annotated[int, Field(ge=0)]]   # object id -> model variant
     # every light's colour temperature; at the default, the colours the house files give the lights
     light_temperature: Annotated[float, Knob("kelvin", 1000.0, 10000.0)] = 2700.0
+    # every lamp's dimmer, a share of its power; at the default, the power the house files give it
+    lamp_dimmer: Annotated[float, Knob("share of full power", 0.1, 1.0)] = 1.0
 
     def changed(self, **fields: Any) -> Self:
         """A copy with ``fields`` replaced, validated like the original (a ValueError if one is bad)."""

@@ -99,6 +99,12 @@ def lamps_at(lights: Iterable[Light], kelvin: float) -> list[Light]:
             for lt in lights]
 
 
+def dimmed(lights: Iterable[Light], level: float) -> list[Light]:
+    """``lights`` with their dimmers at ``level`` (a share of full power): what they shed and what
+    comes back as room ambient scale with it, and so does their fixtures' glow above its floor."""
+    return [replace(lt, intensity=lt.intensity * level) for lt in lights]
+
+
 def black_body(kelvin: float) -> RGB:
     """Linear-ish RGB (0..1) of a black body at ``kelvin`` (Tanner Helland's fit, 1000 K to 40000 K)."""
     t = kelvin / 100.0
@@ -203,7 +209,8 @@ def scene_lights(house: House, state: WorldState, lamps_on: bool = True) -> Scen
     """The light of ``house`` at ``state``; ``lamps_on`` False leaves every lamp out (daylight only)."""
     sun = sun_light(state.sun_angle)
     on = [lt for lt in house.lights if state.lights.get(lt.id, False)] if lamps_on else []
-    lamps = tuple(lamps_at(on, state.settings().light_temperature))
+    looks = state.settings()
+    lamps = tuple(dimmed(lamps_at(on, looks.light_temperature), looks.lamp_dimmer))
     return SceneLights(sun, outdoors(sun), WINDOW_RADIANCE * indoor_daylight(sun), lamps,
                        {room.id: room_ambient(house, room, sun, lamps) for room in house.rooms})
 
