@@ -57,12 +57,18 @@ def worlds():
         yield {"gl": gl, "tiny": tiny}
 
 
-@pytest.mark.parametrize("renderer", ["gl", "tiny"])
-def test_cooler_lights_make_a_bluer_room_and_the_footprint_records_them(worlds, renderer):
-    world = worlds[renderer]
+def _night_room(world):
+    """Room A at night lit by its ceiling light alone, and a camera at a fixed exposure."""
     appearance = Appearance(world)
     appearance.change({"sun_angle": "night", "lights": {"all": "off", "Light_0": "on"}})
     camera = SmartCamera(world, replace(PROFILE.camera, quality="realistic"), CameraOptions(manual_exposure=3.0))
+    return appearance, camera
+
+
+@pytest.mark.parametrize("renderer", ["gl", "tiny"])
+def test_cooler_lights_make_a_bluer_room_and_the_footprint_records_them(worlds, renderer):
+    world = worlds[renderer]
+    appearance, camera = _night_room(world)
     blue_over_red = {}
     for kelvin in (WARM, COOL, WARM):        # back again: the renderer follows every change
         reply = appearance.change({"light_temperature": kelvin})
@@ -110,9 +116,7 @@ def test_the_light_model_scales_every_lamp_and_the_change_report_relights_them(w
 @pytest.mark.parametrize("renderer", ["gl", "tiny"])
 def test_a_dimmed_room_is_darker_and_the_footprint_records_it(worlds, renderer):
     world = worlds[renderer]
-    appearance = Appearance(world)
-    appearance.change({"sun_angle": "night", "lights": {"all": "off", "Light_0": "on"}})
-    camera = SmartCamera(world, replace(PROFILE.camera, quality="realistic"), CameraOptions(manual_exposure=3.0))
+    appearance, camera = _night_room(world)
     brightness = {}
     for level in (1.0, 0.3, 1.0):            # back again: the renderer follows every change
         assert appearance.change({"lamp_dimmer": level})["settings"]["lamp_dimmer"] == level
