@@ -66,9 +66,11 @@ class FrameDeveloper:
         self._meter_weights = 1.0 + (CENTRE_WEIGHT - 1.0) * np.exp(-(rows ** 2 + cols ** 2) / (2 * CENTRE_SPREAD ** 2))
 
     def release(self) -> None:
-        for obj in (self.tonemap_program, self.meter_program, *self.sensor_programs.values(), self.tonemap_vao,
-                    self.meter_vao, *self.sensor_vaos.values(), self.ldr, self.ldr_fbo, self.meter, self.meter_fbo,
-                    self.signal, self.signal_fbo, self.balance, self.balance_fbo):
+        owned: list[moderngl.Program | moderngl.VertexArray | moderngl.Texture | moderngl.Framebuffer] = [
+            self.tonemap_program, self.meter_program, *self.sensor_programs.values(), self.tonemap_vao,
+            self.meter_vao, *self.sensor_vaos.values(), self.ldr, self.ldr_fbo, self.meter, self.meter_fbo,
+            self.signal, self.signal_fbo, self.balance, self.balance_fbo]
+        for obj in owned:
             obj.release()
 
     def auto_exposure(self, blocks: np.ndarray) -> float:
