@@ -17,8 +17,8 @@ from sensor_msgs.msg import Image
 from ravh_msgs_py import names as n
 from ravh_msgs_py.client import RavhClient
 from ravh_msgs_py.query import BUSY
+from ravh_sim.nodes.appearance_budget import WorkBudget
 from ravh_sim.nodes.common import SENSOR_QOS, STATE_QOS
-from ravh_sim.nodes.sim_node import WorkBudget
 
 BURST_HZ = 50.0
 BURST_S = 8.0
