@@ -222,7 +222,7 @@ def _showroom(records: list[library.LibraryRecord]):
     models = {}
     for record, obj in zip(records, house.objects):
         models[obj.id] = next(v for v in range(model_count(obj))
-                              if object_parts(house, obj, v).model.model.id == record.id)
+                              if library.record(object_parts(house, obj, v).model).id == record.id)
     settings = resolve(load_settings(), house)
     return house, settings.changed(models={**settings.models, **models})
 
@@ -295,10 +295,10 @@ def test_glass_is_opaque_to_the_laser_and_to_depth():
         laser_checked, depth_checked, missed = set(), set(), []
         for record, obj in zip(records, house.objects):
             poses, fitted = _views(house, world, obj)
-            glass = fitted.model.glass_faces
+            glass = library.glass_faces(fitted)
             assert glass.any(), record.id
             corners = (fitted.vertices @ pose_matrix(*world.object_pose(obj.id))[:, :3].T
-                       + pose_matrix(*world.object_pose(obj.id))[:, 3])[fitted.model.faces[glass]]
+                       + pose_matrix(*world.object_pose(obj.id))[:, 3])[fitted.faces[glass]]
             middles = corners.mean(axis=1)
             normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
             twice_area = np.linalg.norm(normals, axis=1)

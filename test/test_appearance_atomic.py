@@ -39,7 +39,7 @@ def full_state(world: World) -> dict:
             pb.getBasePositionAndOrientation(inst.body, physicsClientId=c),
             pb.getCollisionShapeData(inst.body, -1, physicsClientId=c),
             tuple(v[:8] for v in pb.getVisualShapeData(inst.body, physicsClientId=c)),
-            visual.paint, visual.surface, None if visual.mesh is None else visual.mesh.triangle_count)
+            visual.paint, visual.surface, None if visual.mesh is None else len(visual.mesh.faces))
     return {"settings": world.state.settings(), "revisions": (world.state.revision, world.state.layout_revision),
             "footprint": make_footprint(world.house, world.state.settings()), "bodies": bodies,
             "drawn": len(world.visuals)}                  # bodies in the house (swapped-out ones are parked)

@@ -7,10 +7,21 @@ import itertools
 import cv2
 import numpy as np
 import pytest
+import trimesh
 
 from ravh_sim.world.facing import choose_facing, front_axis, side_distances, suits_box
 from ravh_sim.world.furniture import OBJECT_TYPES, build_model, variant_count
-from ravh_sim.world.mesh import Mesh, box, cylinder, ellipsoid, frustum, rounded_box
+from ravh_sim.world.mesh import (
+    box,
+    colours,
+    cylinder,
+    ellipsoid,
+    frustum,
+    merged,
+    rounded_box,
+    transformed,
+    write_palette_obj,
+)
 from ravh_sim.world.palette import PALETTE, Palette
 
 # Upstream Robot@VirtualHome model counts per type (from the house data).
@@ -39,16 +50,16 @@ def sizes_for(object_type: str) -> list[tuple[float, float, float]]:
     return [(sx, sy, sz), (sy, sx, sz), (0.01, 0.01, 0.01), (0.01, 2.0, 0.5), (2.5, 0.3, 0.02)]
 
 
-def check_model(mesh: Mesh, size: tuple[float, float, float]) -> None:
+def check_model(mesh: trimesh.Trimesh, size: tuple[float, float, float]) -> None:
     half = np.asarray(size) / 2
     assert np.isfinite(mesh.vertices).all()
     assert (np.abs(mesh.vertices) <= half + 1e-6).all(), 'model leaves its box'
-    lo, hi = mesh.bounds()
+    lo, hi = mesh.bounds
     assert ((hi - lo) >= 0.9 * np.asarray(size)).all(), 'model does not fill its box'
-    assert mesh.face_areas().min() > 1e-12 * max(size) ** 2, 'degenerate triangle'
-    assert mesh.colours.min() >= 0 and mesh.colours.max() < len(PALETTE)
+    assert mesh.area_faces.min() > 1e-12 * max(size) ** 2, 'degenerate triangle'
+    assert colours(mesh).min() >= 0 and colours(mesh).max() < len(PALETTE)
     assert mesh.faces.min() >= 0 and mesh.faces.max() < len(mesh.vertices)
-    assert mesh.signed_volume() > 0, 'faces wind inwards'
+    assert mesh.volume > 0, 'faces wind inwards'
 
 
 # --- models ------------------------------------------------------------------------------
@@ -59,17 +70,17 @@ def test_models_fit_their_box_for_every_variant_size_and_facing(object_type):
     for variant, size, facing in itertools.product(variants, sizes_for(object_type), range(4)):
         mesh = build_model(object_type, size, variant, facing)
         check_model(mesh, size)
-        assert mesh.triangle_count <= 500
+        assert len(mesh.faces) <= 500
 
 
 @pytest.mark.parametrize('object_type', ALL_TYPES)
 def test_typical_models_stay_within_triangle_budget(object_type):
     for variant in range(variant_count(object_type)):
-        assert build_model(object_type, typical(object_type), variant, 0).triangle_count <= 400
+        assert len(build_model(object_type, typical(object_type), variant, 0).faces) <= 400
 
 
 def test_average_model_is_cheap():
-    counts = [build_model(t, typical(t), v).triangle_count
+    counts = [len(build_model(t, typical(t), v).faces)
               for t in OBJECT_TYPES for v in range(variant_count(t))]
     assert np.mean(counts) <= 250
 
@@ -81,10 +92,10 @@ def test_variant_counts_follow_upstream_model_counts():
     assert variant_count('SomethingUnknown') == 1
 
 
-def same_mesh(a: Mesh, b: Mesh) -> bool:
+def same_mesh(a: trimesh.Trimesh, b: trimesh.Trimesh) -> bool:
     return (a.vertices.shape == b.vertices.shape and a.faces.shape == b.faces.shape
             and np.allclose(a.vertices, b.vertices) and np.array_equal(a.faces, b.faces)
-            and np.array_equal(a.colours, b.colours))
+            and np.array_equal(colours(a), colours(b)))
 
 
 @pytest.mark.parametrize('object_type', [t for t in OBJECT_TYPES if variant_count(t) > 1])
@@ -104,16 +115,16 @@ def test_models_are_deterministic(object_type, tmp_path):
     a = build_model(object_type, typical(object_type), 1, 3)
     b = build_model(object_type, typical(object_type), 1, 3)
     assert np.array_equal(a.vertices, b.vertices) and np.array_equal(a.faces, b.faces)
-    assert np.array_equal(a.colours, b.colours)
-    a.write_obj(tmp_path / 'a.obj', PALETTE)
-    b.write_obj(tmp_path / 'b.obj', PALETTE)
+    assert np.array_equal(colours(a), colours(b))
+    write_palette_obj(a, tmp_path / 'a.obj', PALETTE)
+    write_palette_obj(b, tmp_path / 'b.obj', PALETTE)
     assert (tmp_path / 'a.obj').read_bytes() == (tmp_path / 'b.obj').read_bytes()
 
 
 def test_bad_sizes_still_give_a_model():
     for size in [(0.0, 0.5, 0.5), (-0.4, 0.5, 0.5), (float('nan'), 0.5, 0.5)]:
         mesh = build_model('Picture', size, 0)
-        assert np.isfinite(mesh.vertices).all() and mesh.face_areas().min() > 0
+        assert np.isfinite(mesh.vertices).all() and mesh.area_faces.min() > 0
 
 
 @pytest.mark.parametrize('object_type', OBJECT_TYPES)
@@ -138,8 +149,8 @@ def test_front_axes_of_typical_furniture():
 
 def test_flat_wall_items_face_across_their_thin_axis():
     mesh = build_model('Mirror', (0.68, 0.04, 1.05), 0, facing=0)  # facing contradicts the thin axis
-    glass = mesh.colours == PALETTE.index('mirror')
-    cross = mesh.face_cross()[glass]
+    glass = colours(mesh) == PALETTE.index('mirror')
+    cross = mesh.triangles_cross[glass]
     normal = cross[np.argmax(np.linalg.norm(cross, axis=1))]
     assert abs(normal[1]) / np.linalg.norm(normal) > 0.99
 
@@ -161,19 +172,18 @@ PRIMITIVES = {
 @pytest.mark.parametrize('name', PRIMITIVES)
 def test_primitives_are_closed_outward_and_centred(name):
     mesh = PRIMITIVES[name]()
-    lo, hi = mesh.bounds()
+    lo, hi = mesh.bounds
     assert np.allclose((lo + hi) / 2, (1.0, 2.0, 3.0))
     centroids = mesh.vertices[mesh.faces].mean(axis=1) - (1.0, 2.0, 3.0)
-    assert (np.einsum('ij,ij->i', mesh.face_cross(), centroids) > 0).all(), 'a face points inwards'
+    assert (np.einsum('ij,ij->i', mesh.triangles_cross, centroids) > 0).all(), 'a face points inwards'
     edges = np.sort(mesh.faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
     _, uses = np.unique(edges, axis=0, return_counts=True)
     assert (uses == 2).all(), 'mesh is not closed'
-    assert mesh.face_areas().min() > 0 and (mesh.colours == 3).all()
+    assert mesh.area_faces.min() > 0 and (colours(mesh) == 3).all()
 
 
-def extent(mesh: Mesh) -> np.ndarray:
-    lo, hi = mesh.bounds()
-    return hi - lo
+def extent(mesh: trimesh.Trimesh) -> np.ndarray:
+    return mesh.extents
 
 
 def test_primitive_extents_and_triangle_counts():
@@ -182,26 +192,26 @@ def test_primitive_extents_and_triangle_counts():
     assert np.allclose(extent(cylinder((0, 0, 0), 0.3, 0.8, 0, axis='x')), (0.8, 0.6, 0.6))
     assert np.allclose(extent(rounded_box((0, 0, 0), (0.4, 0.6, 0.8), 0, 0.1)), (0.4, 0.6, 0.8))
     assert np.allclose(extent(ellipsoid((0, 0, 0), (0.4, 0.6, 0.8), 0)), (0.4, 0.6, 0.8))
-    assert box((0, 0, 0), (1, 1, 1), 0).triangle_count == 12
-    assert cylinder((0, 0, 0), 1, 1, 0, segments=10).triangle_count == 36
-    assert rounded_box((0, 0, 0), (1, 1, 1), 0, 0.1).triangle_count == 44
+    assert len(box((0, 0, 0), (1, 1, 1), 0).faces) == 12
+    assert len(cylinder((0, 0, 0), 1, 1, 0, segments=10).faces) == 36
+    assert len(rounded_box((0, 0, 0), (1, 1, 1), 0, 0.1).faces) == 44
 
 
 def test_merge_offsets_faces_and_keeps_colours():
     a, b = box((0, 0, 0), (1, 1, 1), 1), cylinder((5, 0, 0), 1, 1, 2)
-    merged = Mesh.merged([a, b])
-    assert merged.triangle_count == a.triangle_count + b.triangle_count
-    assert np.allclose(merged.vertices[merged.faces[a.triangle_count:]], b.vertices[b.faces])
-    assert list(np.unique(merged.colours)) == [1, 2]
+    both = merged([a, b])
+    assert len(both.faces) == len(a.faces) + len(b.faces)
+    assert np.allclose(both.vertices[both.faces[len(a.faces):]], b.vertices[b.faces])
+    assert list(np.unique(colours(both))) == [1, 2]
 
 
 def test_transform_rotates_translates_and_keeps_winding_under_mirroring():
     mesh = box((1.0, 0.0, 0.0), (0.2, 0.4, 0.6), 0)
-    turned = mesh.transformed(np.pi / 2, (0.0, 0.0, 1.0))
+    turned = transformed(mesh, np.pi / 2, (0.0, 0.0, 1.0))
     assert np.allclose(turned.vertices.mean(axis=0), (0.0, 1.0, 1.0))
     assert np.allclose(extent(turned), (0.4, 0.2, 0.6))
-    mirrored = mesh.transformed(np.diag([-1.0, 1.0, 1.0]))
-    assert mirrored.signed_volume() == pytest.approx(mesh.signed_volume())
+    mirrored = transformed(mesh, np.diag([-1.0, 1.0, 1.0]))
+    assert mirrored.volume == pytest.approx(mesh.volume) and mesh.volume > 0
 
 
 def parse_obj(text: str) -> dict[str, list[list[str]]]:
@@ -214,19 +224,17 @@ def parse_obj(text: str) -> dict[str, list[list[str]]]:
 
 
 def test_obj_export_round_trips_geometry_uvs_and_normals(tmp_path):
-    mesh = Mesh.merged([box((0, 0, 0), (1, 2, 3), PALETTE.index('wood_dark')),
-                        frustum((0, 0, 2), 0.5, 0.2, 1.0, PALETTE.index('chrome'), axis='y')])
+    mesh = merged([box((0, 0, 0), (1, 2, 3), PALETTE.index('wood_dark')),
+                   frustum((0, 0, 2), 0.5, 0.2, 1.0, PALETTE.index('chrome'), axis='y')])
     path = tmp_path / 'm.obj'
-    mesh.write_obj(path, PALETTE)
+    write_palette_obj(mesh, path, PALETTE)
     obj = parse_obj(path.read_text())
     vertices = np.array(obj['v'], float)
     uvs, normals = np.array(obj['vt'], float), np.array(obj['vn'], float)
-    assert np.allclose(vertices, mesh.vertices, atol=1e-5)
-    assert len(obj['f']) == mesh.triangle_count
-    unit = mesh.face_cross() / np.linalg.norm(mesh.face_cross(), axis=1, keepdims=True)
-    for face, corners, colour, normal in zip(mesh.faces, obj['f'], mesh.colours, unit):
+    assert len(obj['f']) == len(mesh.faces)
+    for face, corners, colour, normal in zip(mesh.faces, obj['f'], colours(mesh), mesh.face_normals):
         v, t, n = np.array([c.split('/') for c in corners], int).T - 1
-        assert list(v) == list(face)
+        assert np.allclose(vertices[v], mesh.vertices[face], atol=1e-5)
         assert np.allclose(uvs[t], PALETTE.uv(int(colour)), atol=1e-6)
         assert np.allclose(normals[n], normal, atol=1e-3)
 

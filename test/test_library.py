@@ -283,7 +283,7 @@ def test_the_default_variant_is_the_best_proportioned_model(houses):
         quarter = round((default.front - default.yaw) / (np.pi / 2)) % 2      # the box turned to the front
         size = np.asarray(obj.box(0).size)[[1, 0, 2] if quarter else [0, 1, 2]]
         misfits = [library.misfit(np.asarray(r.size), size) for r in models_of(kind_of(obj.type, obj.prefab))]
-        assert library.misfit(np.asarray(default.model.model.record.size), size) == pytest.approx(min(misfits))
+        assert library.misfit(np.asarray(library.record(default.model).size), size) == pytest.approx(min(misfits))
         checked += 1
     assert checked > 30
 
@@ -293,9 +293,9 @@ def test_model_count_and_variants_choose_among_the_kind(houses):
     chair = next(o for o in house.objects if o.type == "Chair" and "office" not in o.prefab.lower())
     count = model_count(chair)
     assert count == len(models_of("Chair"))
-    ids = [object_parts(house, chair, v).model.model.id for v in range(count)]
+    ids = [library.record(object_parts(house, chair, v).model).id for v in range(count)]
     assert len(set(ids)) == count
-    assert object_parts(house, chair, count).model.model.id == ids[0]                  # wraps
+    assert library.record(object_parts(house, chair, count).model).id == ids[0]        # wraps
 
 
 def test_placed_library_models_lie_in_their_box_and_cover_their_pieces(houses):

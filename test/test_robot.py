@@ -146,7 +146,7 @@ def model_distance(world: World, obj_id: str) -> Callable[[tuple], float]:
     xyz = np.column_stack([placed.position[0] + c * local[:, 0] - s * local[:, 1],
                            placed.position[1] + s * local[:, 0] + c * local[:, 1],
                            placed.position[2] + local[:, 2]])
-    triangles = xyz[placed.model.model.faces]
+    triangles = xyz[placed.model.faces]
     band = (triangles[:, :, 2].max(axis=1) > floor + 0.02) & (triangles[:, :, 2].min(axis=1) < floor + GIRAFF.height)
     flat = triangles[band][:, :, :2]
 

@@ -17,8 +17,8 @@ import trimesh
 
 from ravh_sim.look.materials import MaterialTable
 from ravh_sim.poses import pose_matrix
-from ravh_sim.world.library import FittedModel
-from ravh_sim.world.mesh import Mesh
+from ravh_sim.world import library
+from ravh_sim.world.mesh import colours
 from ravh_sim.world.scene import Visual, World
 
 FLOATS_PER_VERTEX = 13                       # position 3, normal 3, local 3, material 1, instance 1, uv 2
@@ -37,18 +37,18 @@ class BodyArrays:
     uvs: np.ndarray
 
 
-def palette_arrays(mesh: Mesh) -> BodyArrays:
+def palette_arrays(mesh: trimesh.Trimesh) -> BodyArrays:
     """Corners, crease-aware normals and palette indices of a palette-coloured model."""
     return BodyArrays(mesh.vertices[mesh.faces.ravel()], corner_normals(mesh.vertices, mesh.faces),
-                      np.repeat(mesh.colours, 3), np.zeros((3 * len(mesh.faces), 2)))
+                      np.repeat(colours(mesh), 3), np.zeros((3 * len(mesh.faces), 2)))
 
 
-def model_arrays(fitted: FittedModel, slots: np.ndarray) -> BodyArrays:
+def model_arrays(fitted: trimesh.Trimesh, slots: np.ndarray) -> BodyArrays:
     """Corners, normals, material slots (``slots[k]``: the table index of the model's material k)
     and texture coordinates of a fitted library model."""
-    faces = fitted.model.faces
+    faces = fitted.faces
     return BodyArrays(fitted.vertices[faces.ravel()], corner_normals(fitted.vertices, faces),
-                      np.repeat(slots[fitted.model.face_material], 3), fitted.model.uvs[faces.ravel()])
+                      np.repeat(slots[library.face_material(fitted)], 3), fitted.visual.uv[faces.ravel()])
 
 
 def corner_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -77,7 +77,7 @@ class SceneBuilder:
     def __init__(self, world: World, materials: MaterialTable) -> None:
         self.world, self.materials = world, materials
         self._arrays: dict[int, BodyArrays] = {}           # id(mesh or fitted model) -> its arrays
-        self._kept: dict[int, Mesh | FittedModel] = {}      # keeps those alive (ids stay unique)
+        self._kept: dict[int, trimesh.Trimesh] = {}         # keeps those alive (ids stay unique)
 
     def build(self) -> np.ndarray:
         """(3T, FLOATS_PER_VERTEX) float32 of every visible body, in instance order."""
@@ -96,16 +96,16 @@ class SceneBuilder:
         if visual.structure is not None:
             mesh = visual.structure
             corners = mesh.vertices[mesh.faces.ravel()]
-            normals = mesh.normals[mesh.faces.ravel()]
+            normals = mesh.vertex_normals[mesh.faces.ravel()]
             material = np.full(len(corners), self.materials.paint(visual.paint, visual.surface), np.float64)
             return _pack(corners, normals, corners, material, instance_id, np.zeros((len(corners), 2)))
         source = visual.model if visual.model is not None else visual.mesh
         assert source is not None
         key = id(source)
         if key not in self._arrays:
-            if isinstance(source, FittedModel):
-                slots = np.array([self.materials.library(source.model.id, k, m)
-                                  for k, m in enumerate(source.model.materials)])
+            if visual.model is not None:
+                record = library.record(source)
+                slots = np.array([self.materials.library(record.id, k, m) for k, m in enumerate(record.materials)])
                 self._arrays[key] = model_arrays(source, slots)
             else:
                 self._arrays[key] = palette_arrays(source)

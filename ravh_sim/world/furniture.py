@@ -22,12 +22,13 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import trimesh
 
 from ravh_sim.world.facing import front_axis, suits_box
-from ravh_sim.world.mesh import Mesh, Vec3, box, frustum, rounded_box
+from ravh_sim.world.mesh import Vec3, box, coloured, colours, frustum, merged, rounded_box, scaled, transformed
 from ravh_sim.world.palette import PALETTE
 
-Parts = list[Mesh]
+Parts = list[trimesh.Trimesh]
 Builder = Callable[[float, float, float, int, str], Parts]
 
 MIN_EXTENT = 1e-3
@@ -50,36 +51,36 @@ def _corners(x0: float, x1: float, y0: float, y1: float, z0: float,
     return (lo + hi) / 2, np.maximum(hi - lo, _TINY)
 
 
-def _blk(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float, colour: str) -> Mesh:
+def _blk(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float, colour: str) -> trimesh.Trimesh:
     """Box between two corners."""
     return box(*_corners(x0, x1, y0, y1, z0, z1), _c(colour))
 
 
 def _soft(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float, colour: str,
-          bevel: float) -> Mesh:
+          bevel: float) -> trimesh.Trimesh:
     """Box with chamfered edges between two corners (cushions, mattresses)."""
     return rounded_box(*_corners(x0, x1, y0, y1, z0, z1), _c(colour), bevel)
 
 
 def _disc(x: float, y: float, z0: float, z1: float, rx: float, ry: float, colour: str,
-          segments: int = 8, top: float = 1.0) -> Mesh:
+          segments: int = 8, top: float = 1.0) -> trimesh.Trimesh:
     """Vertical elliptic cylinder, or a frustum whose top radii are ``top`` times the bottom ones."""
     unit = frustum((0.0, 0.0, 0.0), 1.0, top, max(abs(z1 - z0), _TINY), _c(colour), segments)
-    return unit.scaled((max(rx, _TINY), max(ry, _TINY), 1.0)).transformed(0.0, (x, y, (z0 + z1) / 2))
+    return transformed(scaled(unit, (max(rx, _TINY), max(ry, _TINY), 1.0)), 0.0, (x, y, (z0 + z1) / 2))
 
 
-def _rod(p0: Sequence[float], p1: Sequence[float], r: float, colour: str, segments: int = 6) -> Mesh:
+def _rod(p0: Sequence[float], p1: Sequence[float], r: float, colour: str, segments: int = 6) -> trimesh.Trimesh:
     """Round rod between two points."""
     r = max(r, _TINY)
     return _along(frustum((0.0, 0.0, 0.0), r, r, 1.0, _c(colour), segments), p0, p1)
 
 
-def _beam(p0: Sequence[float], p1: Sequence[float], t: float, colour: str, width: float = 0.0) -> Mesh:
+def _beam(p0: Sequence[float], p1: Sequence[float], t: float, colour: str, width: float = 0.0) -> trimesh.Trimesh:
     """Bar of section t x t (or t x width) between two points."""
     return _along(box((0.0, 0.0, 0.0), (max(t, _TINY), max(width or t, _TINY), 1.0), _c(colour)), p0, p1)
 
 
-def _along(unit: Mesh, p0: Sequence[float], p1: Sequence[float]) -> Mesh:
+def _along(unit: trimesh.Trimesh, p0: Sequence[float], p1: Sequence[float]) -> trimesh.Trimesh:
     """Stretch a unit-length part lying along z so it runs from p0 to p1."""
     a, b = np.asarray(p0, np.float64), np.asarray(p1, np.float64)
     length = float(np.linalg.norm(b - a))
@@ -88,7 +89,7 @@ def _along(unit: Mesh, p0: Sequence[float], p1: Sequence[float]) -> Mesh:
     u = np.cross(helper, axis)
     u /= np.linalg.norm(u)
     frame = np.column_stack([u, np.cross(axis, u), axis])
-    return unit.scaled((1.0, 1.0, max(length, _TINY))).transformed(frame, (a + b) / 2)
+    return transformed(scaled(unit, (1.0, 1.0, max(length, _TINY))), frame, (a + b) / 2)
 
 
 def _split(lo: float, hi: float, n: int) -> list[tuple[float, float]]:
@@ -197,7 +198,7 @@ def _canvas(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float, ar
     """A simple painting: background bands (layer 0) and motifs standing slightly proud of them."""
     cw, ch, step = y1 - y0, z1 - z0, 0.15 * (x1 - x0)
 
-    def at(a: float, b: float, c: float, e: float, colour: str, layer: int = 1) -> Mesh:
+    def at(a: float, b: float, c: float, e: float, colour: str, layer: int = 1) -> trimesh.Trimesh:
         return _blk(x0 if layer == 0 else x1, x1 + layer * step, y0 + a * cw, y0 + b * cw,
                     z0 + c * ch, z0 + e * ch, colour)
 
@@ -228,10 +229,10 @@ def _mirror(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
         _blk(0.0, 0.7 * d, -w / 2 + f, w / 2 - f, f, h - f, 'mirror')]
 
 
-def _oval(x0: float, x1: float, ry: float, rz: float, zc: float, colour: str) -> Mesh:
+def _oval(x0: float, x1: float, ry: float, rz: float, zc: float, colour: str) -> trimesh.Trimesh:
     """Elliptic slab between x0 and x1, facing +x, centred on y = 0 and z = zc."""
     unit = frustum((0.0, 0.0, 0.0), 1.0, 1.0, max(x1 - x0, _TINY), _c(colour), 12, axis='x')
-    return unit.scaled((1.0, ry, rz)).transformed(0.0, ((x0 + x1) / 2, 0.0, zc))
+    return transformed(scaled(unit, (1.0, ry, rz)), 0.0, ((x0 + x1) / 2, 0.0, zc))
 
 
 def _keyboard(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
@@ -346,7 +347,7 @@ def variant_count(object_type: str) -> int:
 
 
 def build_model(object_type: str, size: Vec3, variant: int, facing: int = 0,
-                prefab: str = '') -> Mesh:
+                prefab: str = '') -> trimesh.Trimesh:
     """Model of ``object_type`` filling the upright box ``size`` (sx, sy, sz) centred at the origin.
 
     ``variant`` is taken modulo ``variant_count``; ``facing`` (0..3) makes the
@@ -355,7 +356,7 @@ def build_model(object_type: str, size: Vec3, variant: int, facing: int = 0,
     a wardrobe's doors on its long side) turn a quarter when ``facing`` does
     not suit the box.
     """
-    return Mesh.merged(build_parts(object_type, size, variant, facing, prefab))
+    return merged(build_parts(object_type, size, variant, facing, prefab))
 
 
 def build_parts(object_type: str, size: Vec3, variant: int, facing: int = 0,
@@ -373,8 +374,8 @@ def build_parts(object_type: str, size: Vec3, variant: int, facing: int = 0,
         facing = (facing + 1) % 4
     d, w, h = extents[[0, 1, 2] if facing % 2 == 0 else [1, 0, 2]]
     parts = spec.build(d, w, h, int(variant) % spec.variants, prefab or '')
-    lo, hi = Mesh.merged(parts).bounds()
-    return [_fit(part, lo, hi, (d, w, h)).transformed(facing * np.pi / 2) for part in parts]
+    lo, hi = merged(parts).bounds
+    return [transformed(_fit(part, lo, hi, (d, w, h)), facing * np.pi / 2) for part in parts]
 
 
 def _clean_size(size: Vec3) -> np.ndarray:
@@ -382,8 +383,8 @@ def _clean_size(size: Vec3) -> np.ndarray:
     return np.maximum(np.where(np.isfinite(values), values, MIN_EXTENT), MIN_EXTENT)
 
 
-def _fit(part: Mesh, lo: np.ndarray, hi: np.ndarray, size: Sequence[float]) -> Mesh:
+def _fit(part: trimesh.Trimesh, lo: np.ndarray, hi: np.ndarray, size: Sequence[float]) -> trimesh.Trimesh:
     """Map ``part`` as the box between ``lo`` and ``hi`` (the whole model's bounds) maps exactly
     onto a box of ``size`` centred at the origin."""
     scale = np.asarray(size, np.float64) / np.maximum(hi - lo, 1e-12)
-    return Mesh((part.vertices - (lo + hi) / 2) * scale, part.faces, part.colours)
+    return coloured((part.vertices - (lo + hi) / 2) * scale, part.faces, colours(part))

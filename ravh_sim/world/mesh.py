@@ -1,4 +1,4 @@
-"""A small triangle-mesh type with low-poly primitives and OBJ export.
+"""Palette-coloured meshes: low-poly primitives and their OBJ export.
 
 Why: pybullet's EGL renderer crashes on inline vertex meshes but renders OBJ
 files, and every body costs a draw call on the software renderer.  So each
@@ -6,121 +6,116 @@ object is assembled from primitives into ONE mesh whose faces carry palette
 colour indices, and written as one OBJ file whose UVs point into the shared
 palette texture (see ``palette.py``).
 
+One mesh type everywhere: ``trimesh.Trimesh``.  What it lacks travels in it:
+a palette colour per face in ``face_attributes`` (:func:`coloured`,
+:func:`colours`), texture coordinates in a ``TextureVisuals``
+(:func:`uv_visual`; library models add a material slot per face, see
+``library.py``).  Meshes are built with ``process=False``, so vertices and
+faces stay exactly as given, and transformed here rather than by trimesh's
+homogeneous matrices, so every coordinate keeps its bits.
+
 Conventions: metres, right-handed, z up; faces are counter-clockwise seen
 from outside, so the right-hand normal points outwards.
 """
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
 import numpy as np
+import trimesh
+from trimesh.exchange.obj import export_obj
+from trimesh.visual import TextureVisuals
+from trimesh.visual.material import SimpleMaterial
 
 from ravh_sim.poses import rotation_z
 
 Vec3 = Sequence[float] | np.ndarray          # three floats, as a sequence or an array
+PALETTE_INDEX = 'palette'                    # face attribute: each face's palette colour
 
 
 class UvSource(Protocol):
-    """What ``Mesh.write_obj`` needs from a palette."""
+    """What :func:`write_palette_obj` needs from a palette."""
 
     def uv(self, index: int) -> tuple[float, float]: ...
 
 
-@dataclass(frozen=True)
-class Mesh:
+def coloured(vertices: np.ndarray, faces: np.ndarray, colours: np.ndarray) -> trimesh.Trimesh:
     """Triangles with one palette colour index per face."""
+    faces = np.asarray(faces, np.int64).reshape(-1, 3)
+    colours = np.asarray(colours, np.int32).reshape(-1)
+    if len(colours) != len(faces):
+        raise ValueError('need exactly one colour per face')
+    return trimesh.Trimesh(np.asarray(vertices, np.float64).reshape(-1, 3), faces, process=False,
+                           face_attributes={PALETTE_INDEX: colours})
 
-    vertices: np.ndarray  # (N, 3) float64
-    faces: np.ndarray  # (M, 3) int32, counter-clockwise seen from outside
-    colours: np.ndarray  # (M,) int32 palette indices
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, 'vertices', np.asarray(self.vertices, np.float64).reshape(-1, 3))
-        object.__setattr__(self, 'faces', np.asarray(self.faces, np.int32).reshape(-1, 3))
-        object.__setattr__(self, 'colours', np.asarray(self.colours, np.int32).reshape(-1))
-        if len(self.colours) != len(self.faces):
-            raise ValueError('need exactly one colour per face')
+def colours(mesh: trimesh.Trimesh) -> np.ndarray:
+    """(M,) palette colour index of each face."""
+    return mesh.face_attributes[PALETTE_INDEX]
 
-    @staticmethod
-    def merged(meshes: Iterable[Mesh]) -> Mesh:
-        """One mesh holding all triangles of ``meshes``."""
-        meshes = list(meshes)
-        offsets = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
-        return Mesh(
-            np.concatenate([m.vertices for m in meshes] or [np.zeros((0, 3))]),
-            np.concatenate([m.faces + o for m, o in zip(meshes, offsets)] or [np.zeros((0, 3))]),
-            np.concatenate([m.colours for m in meshes] or [np.zeros(0)]))
 
-    @property
-    def triangle_count(self) -> int:
-        return len(self.faces)
+def uv_visual(uv: np.ndarray) -> TextureVisuals:
+    """Per-vertex texture coordinates; the image (palette, paint, library texture) is bound by
+    whoever draws."""
+    return TextureVisuals(uv=uv, material=SimpleMaterial())
 
-    def transformed(self, rotation: float | np.ndarray = 0.0,
-                    translation: Vec3 = (0.0, 0.0, 0.0)) -> Mesh:
-        """Rotate (yaw angle in radians, or a 3x3 matrix), then translate.
 
-        A mirroring matrix (negative determinant) also reverses the face
-        winding so faces stay counter-clockwise seen from outside.
-        """
-        matrix = np.asarray(rotation, np.float64)
-        if matrix.ndim == 0:                                  # a yaw angle
-            matrix = rotation_z(float(matrix))
-        faces = self.faces if np.linalg.det(matrix) > 0 else self.faces[:, ::-1]
-        return Mesh(self.vertices @ matrix.T + np.asarray(translation, np.float64), faces, self.colours)
+def merged(meshes: Iterable[trimesh.Trimesh]) -> trimesh.Trimesh:
+    """One palette mesh holding all triangles of ``meshes``."""
+    meshes = list(meshes)
+    offsets = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
+    return coloured(np.concatenate([m.vertices for m in meshes] or [np.zeros((0, 3))]),
+                    np.concatenate([m.faces + o for m, o in zip(meshes, offsets)] or [np.zeros((0, 3))]),
+                    np.concatenate([colours(m) for m in meshes] or [np.zeros(0)]))
 
-    def scaled(self, factors: Vec3 | float) -> Mesh:
-        """Scale about the origin per axis; a mirroring scale also reverses the face winding."""
-        per_axis = np.broadcast_to(np.asarray(factors, np.float64), (3,))
-        faces = self.faces if np.prod(np.sign(per_axis)) > 0 else self.faces[:, ::-1]
-        return Mesh(self.vertices * per_axis, faces, self.colours)
 
-    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """Axis-aligned (min corner, max corner)."""
-        return self.vertices.min(axis=0), self.vertices.max(axis=0)
+def transformed(mesh: trimesh.Trimesh, rotation: float | np.ndarray = 0.0,
+                translation: Vec3 = (0.0, 0.0, 0.0)) -> trimesh.Trimesh:
+    """Rotate (yaw angle in radians, or a 3x3 matrix), then translate.
 
-    def face_cross(self) -> np.ndarray:
-        """Per-face (v1 - v0) x (v2 - v0): outward, with twice the area as length."""
-        v0, v1, v2 = (self.vertices[self.faces[:, k]] for k in range(3))
-        return np.cross(v1 - v0, v2 - v0)
+    A mirroring matrix (negative determinant) also reverses the face
+    winding so faces stay counter-clockwise seen from outside.
+    """
+    matrix = np.asarray(rotation, np.float64)
+    if matrix.ndim == 0:                                  # a yaw angle
+        matrix = rotation_z(float(matrix))
+    faces = mesh.faces if np.linalg.det(matrix) > 0 else mesh.faces[:, ::-1]
+    return coloured(np.asarray(mesh.vertices) @ matrix.T + np.asarray(translation, np.float64), faces,
+                    colours(mesh))
 
-    def face_areas(self) -> np.ndarray:
-        return 0.5 * np.linalg.norm(self.face_cross(), axis=1)
 
-    def signed_volume(self) -> float:
-        """Enclosed volume; positive when faces wind outwards."""
-        v0, v1, v2 = (self.vertices[self.faces[:, k]] for k in range(3))
-        return float(np.einsum('ij,ij->', v0, np.cross(v1, v2)) / 6.0)
+def scaled(mesh: trimesh.Trimesh, factors: Vec3 | float) -> trimesh.Trimesh:
+    """Scale about the origin per axis; a mirroring scale also reverses the face winding."""
+    per_axis = np.broadcast_to(np.asarray(factors, np.float64), (3,))
+    faces = mesh.faces if np.prod(np.sign(per_axis)) > 0 else mesh.faces[:, ::-1]
+    return coloured(np.asarray(mesh.vertices) * per_axis, faces, colours(mesh))
 
-    def write_obj(self, path: str | Path, palette: UvSource) -> None:
-        """Write a flat-shaded, palette-textured Wavefront OBJ file.
 
-        Each face gets its own normal and the UV of its colour's palette cell;
-        normals and UVs are de-duplicated in sorted order, so the same mesh
-        always produces a byte-identical file.
-        """
-        Path(path).write_text(self.obj_text(palette), encoding='ascii')
+def write_palette_obj(mesh: trimesh.Trimesh, path: str | Path, palette: UvSource) -> None:
+    """Write a flat-shaded, palette-textured Wavefront OBJ file (trimesh's writer).
 
-    def obj_text(self, palette: UvSource) -> str:
-        """The text ``write_obj`` writes."""
-        cross = self.face_cross()
-        length = np.linalg.norm(cross, axis=1, keepdims=True)
-        normals = np.where(length > 0, cross / np.where(length > 0, length, 1.0), (0.0, 0.0, 1.0))
-        normals, normal_of_face = np.unique(_clean(normals, 4), axis=0, return_inverse=True)
-        used, uv_of_face = np.unique(self.colours, return_inverse=True)
-        uvs = [palette.uv(int(c)) for c in used]
-        per_face = np.column_stack([uv_of_face.reshape(-1), normal_of_face.reshape(-1)]) + 1
-        corner = np.concatenate([self.faces[:, :, None] + 1, np.repeat(per_face[:, None, :], 3, axis=1)],
-                                axis=2)  # (face, corner, v/vt/vn)
-        lines = [f'# ravh_sim procedural mesh: {len(self.vertices)} vertices, '
-                 f'{len(self.faces)} triangles']
-        lines += ['v %.5f %.5f %.5f' % tuple(v) for v in _clean(self.vertices, 5)]
-        lines += ['vt %.6f %.6f' % uv for uv in uvs]
-        lines += ['vn %.4f %.4f %.4f' % tuple(n) for n in normals]
-        lines += ['f %d/%d/%d %d/%d/%d %d/%d/%d' % tuple(c.ravel()) for c in corner]
-        return '\n'.join(lines) + '\n'
+    Each face gets its own three corners, with the face's normal and the UV of its colour's
+    palette cell; positions are rounded to 5 decimals and normals to 4, so the same mesh always
+    produces a byte-identical file.
+    """
+    Path(path).write_text(palette_obj_text(mesh, palette), encoding='ascii')
+
+
+def palette_obj_text(mesh: trimesh.Trimesh, palette: UvSource) -> str:
+    """The text :func:`write_palette_obj` writes."""
+    cross = mesh.triangles_cross
+    length = np.linalg.norm(cross, axis=1, keepdims=True)
+    normals = np.where(length > 0, cross / np.where(length > 0, length, 1.0), (0.0, 0.0, 1.0))
+    used, uv_of_face = np.unique(colours(mesh), return_inverse=True)
+    uvs = np.array([palette.uv(int(c)) for c in used], np.float64).reshape(-1, 2)
+    corners = trimesh.Trimesh(_clean(np.asarray(mesh.vertices), 5)[mesh.faces.ravel()],
+                              np.arange(3 * len(mesh.faces)).reshape(-1, 3), process=False,
+                              vertex_normals=np.repeat(_clean(normals, 4), 3, axis=0),
+                              visual=uv_visual(np.repeat(uvs[uv_of_face.reshape(-1)], 3, axis=0)))
+    return export_obj(corners, include_normals=True, digits=6,
+                      header=f'ravh_sim procedural mesh: {len(mesh.faces)} triangles')
 
 
 def _clean(values: np.ndarray, decimals: int) -> np.ndarray:
@@ -142,18 +137,18 @@ def _quads(quads: Iterable[Sequence[int]]) -> np.ndarray:
     return np.array([tri for a, b, c, d in quads for tri in ((a, b, c), (a, c, d))])
 
 
-def _solid(vertices: np.ndarray, faces: np.ndarray, colour: int) -> Mesh:
-    return Mesh(vertices, faces, np.full(len(faces), colour))
+def _solid(vertices: np.ndarray, faces: np.ndarray, colour: int) -> trimesh.Trimesh:
+    return coloured(vertices, faces, np.full(len(faces), colour))
 
 
-def box(center: Vec3, size: Vec3, colour: int) -> Mesh:
+def box(center: Vec3, size: Vec3, colour: int) -> trimesh.Trimesh:
     """Axis-aligned cuboid (12 triangles)."""
     corners = np.array([[x, y, z] for z in (-0.5, 0.5) for y in (-0.5, 0.5) for x in (-0.5, 0.5)])
     return _solid(corners * np.abs(size) + np.asarray(center, np.float64), _quads(_BOX_QUADS), colour)
 
 
 def frustum(center: Vec3, radius_bottom: float, radius_top: float, height: float, colour: int,
-            segments: int = 8, axis: str = 'z') -> Mesh:
+            segments: int = 8, axis: str = 'z') -> trimesh.Trimesh:
     """Tapered cylinder along ``axis``; a zero radius gives a cone (apex, no cap).
 
     ``segments`` divisible by 4 makes the bounding box exactly +-radius.
@@ -178,12 +173,12 @@ def frustum(center: Vec3, radius_bottom: float, radius_top: float, height: float
 
 
 def cylinder(center: Vec3, radius: float, height: float, colour: int,
-             segments: int = 8, axis: str = 'z') -> Mesh:
+             segments: int = 8, axis: str = 'z') -> trimesh.Trimesh:
     """Closed prism approximating a cylinder (4 * segments - 4 triangles)."""
     return frustum(center, radius, radius, height, colour, segments, axis)
 
 
-def _convex(vertices: np.ndarray, faces: np.ndarray, center: Vec3, colour: int) -> Mesh:
+def _convex(vertices: np.ndarray, faces: np.ndarray, center: Vec3, colour: int) -> trimesh.Trimesh:
     """Orient faces of a convex solid centred at the origin outwards, then place it."""
     v0, v1, v2 = (vertices[faces[:, k]] for k in range(3))
     inward = np.einsum('ij,ij->i', np.cross(v1 - v0, v2 - v0), v0 + v1 + v2) < 0
@@ -191,7 +186,7 @@ def _convex(vertices: np.ndarray, faces: np.ndarray, center: Vec3, colour: int) 
     return _solid(vertices + np.asarray(center, np.float64), faces, colour)
 
 
-def rounded_box(center: Vec3, size: Vec3, colour: int, bevel: float) -> Mesh:
+def rounded_box(center: Vec3, size: Vec3, colour: int, bevel: float) -> trimesh.Trimesh:
     """Cuboid with all 12 edges chamfered by ``bevel`` (44 triangles).
 
     Good for cushions, mattresses and pillows.  Falls back to ``box`` when
@@ -241,22 +236,21 @@ _ICOSAHEDRON_FACES = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0,
                                [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]])
 
 
-def ellipsoid(center: Vec3, size: Vec3, colour: int) -> Mesh:
+def ellipsoid(center: Vec3, size: Vec3, colour: int) -> trimesh.Trimesh:
     """Icosahedron stretched to fill ``size`` (20 triangles): foliage, globes."""
     unit = _ICOSAHEDRON / _ICOSAHEDRON.max(axis=0)
     return _convex(unit * np.abs(np.asarray(size, np.float64)) / 2, _ICOSAHEDRON_FACES, center, colour)
 
 
-def hulls_obj_text(parts: Sequence[Mesh]) -> str:
+def hulls_obj_text(parts: Sequence[trimesh.Trimesh]) -> str:
     """OBJ text with one object per part (positions and faces only) for a collision shape.
 
     pybullet loads such a file as a compound of one convex hull per object, which is exactly the
     part when the part is convex (as every primitive here is).
     """
-    lines, offset = [f'# ravh_sim collision parts: {len(parts)} convex hulls'], 1
+    scene = trimesh.Scene()
     for i, part in enumerate(parts):
-        lines.append(f'o part{i}')
-        lines += ['v %.5f %.5f %.5f' % tuple(v) for v in _clean(part.vertices, 5)]
-        lines += ['f %d %d %d' % tuple(f) for f in part.faces + offset]
-        offset += len(part.vertices)
-    return '\n'.join(lines) + '\n'
+        scene.add_geometry(trimesh.Trimesh(_clean(np.asarray(part.vertices), 5), part.faces, process=False),
+                           geom_name=f'part{i}')
+    return export_obj(scene, include_normals=False, include_texture=False, digits=5,
+                      header=f'ravh_sim collision parts: {len(parts)} convex hulls')

@@ -30,18 +30,19 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pybullet as pb
+import trimesh
 
 from ravh_sim.poses import quaternion_from_yaw
 from ravh_sim.world import paints
 from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances
 from ravh_sim.world.house import House, HouseObject, Wall
-from ravh_sim.world.library import FittedModel, palette_stand_in
-from ravh_sim.world.mesh import Mesh, hulls_obj_text
+from ravh_sim.world.library import palette_stand_in, record
+from ravh_sim.world.mesh import colours, hulls_obj_text, write_palette_obj
 from ravh_sim.world.palette import PALETTE
 from ravh_sim.world.settings import Resolved
 from ravh_sim.world.solids import Placed, door_pose, object_parts
 from ravh_sim.world.state import WorldState
-from ravh_sim.world.structure import TexturedMesh, floor_mesh, solid_walls, wall_mesh
+from ravh_sim.world.structure import floor_mesh, solid_walls, wall_mesh, write_textured_obj
 
 NON_SOLID_TYPES = frozenset({"Station"})      # drawn, but the robot starts on it
 OPEN_DOOR_DROP = 50.0                          # m an open door's leaf sinks, out of every sensor's view
@@ -226,12 +227,12 @@ class World:
         mesh = placed.mesh() if placed.model is None else None
         drawn = mesh
         if mesh is not None:
-            self.triangle_count += mesh.triangle_count
+            self.triangle_count += len(mesh.faces)
         if placed.model is not None:
             drawn = palette_stand_in(placed.model) if self._pybullet_draws else None
-            self.triangle_count += len(placed.model.model.faces)
+            self.triangle_count += len(placed.model.faces)
         if drawn is not None and self._pybullet_draws:
-            path = self._asset(mesh_bytes(drawn), ".obj", lambda p: drawn.write_obj(p, PALETTE))
+            path = self._asset(mesh_bytes(drawn), ".obj", lambda p: write_palette_obj(drawn, p, PALETTE))
             body = self._new_body(collision, placed.position, placed.yaw, path)
             self._set_look(body, self._texture("palette"), [1, 1, 1, 1])
         else:
@@ -239,13 +240,12 @@ class World:
         self.visuals[body] = Visual(mesh=mesh, model=placed.model)
         return body
 
-    def _model_collision(self, fitted: FittedModel) -> int:
+    def _model_collision(self, fitted: trimesh.Trimesh) -> int:
         """A library model collides as its own triangles (a static concave mesh: exact for the laser,
         which then sees what the camera draws), every one of them, glass included (glass is opaque
         to every sensor, :mod:`ravh_sim.world.library`), loaded from a cached OBJ file."""
-        mesh = fitted.mesh
-        key = fitted.model.id.encode() + np.round(fitted.vertices, 5).tobytes()
-        path = self._asset(key, ".obj", lambda p: mesh.export(p, file_type="obj", include_normals=False,
+        key = record(fitted).id.encode() + np.round(fitted.vertices, 5).tobytes()
+        path = self._asset(key, ".obj", lambda p: fitted.export(p, file_type="obj", include_normals=False,
                                                               include_texture=False))
         return pb.createCollisionShape(pb.GEOM_MESH, fileName=str(path), flags=pb.GEOM_FORCE_CONCAVE_TRIMESH,
                                        physicsClientId=self.client)
@@ -256,14 +256,14 @@ class World:
         path = self._asset(text.encode(), ".obj", lambda p: p.write_text(text))
         return pb.createCollisionShape(pb.GEOM_MESH, fileName=str(path), physicsClientId=self.client)
 
-    def _mesh_body(self, mesh: TexturedMesh, collisions: list[int], surface: str) -> int:
+    def _mesh_body(self, mesh: trimesh.Trimesh, collisions: list[int], surface: str) -> int:
         """A piece of structure drawn as ``mesh``, colliding as ``collisions`` (the base's shape, then
         one per fixed link; ``[-1]``: none)."""
         path = None
         if self._pybullet_draws:
-            key = np.concatenate([mesh.vertices.ravel(), mesh.uvs.ravel()]).round(4).tobytes()
-            path = self._asset(key, ".obj", mesh.write_obj)
-        self.triangle_count += mesh.triangle_count
+            key = np.concatenate([mesh.vertices.ravel(), mesh.visual.uv.ravel()]).round(4).tobytes()
+            path = self._asset(key, ".obj", lambda p: write_textured_obj(mesh, p))
+        self.triangle_count += len(mesh.faces)
         body = self._new_body(collisions[0], (0, 0, 0), 0.0, path, links=collisions[1:])
         self.visuals[body] = Visual(structure=mesh, surface=surface)
         return body
@@ -378,9 +378,9 @@ class World:
 class Visual:
     """What a body looks like: a palette-coloured model or a fitted library model (in its body
     frame), or a painted piece of structure (in the house frame) with its current paint."""
-    mesh: Mesh | None = None
-    model: FittedModel | None = None
-    structure: TexturedMesh | None = None
+    mesh: trimesh.Trimesh | None = None
+    model: trimesh.Trimesh | None = None
+    structure: trimesh.Trimesh | None = None
     surface: str = ""                      # walls | floor | ceiling for structure
     paint: str = ""
 
@@ -403,4 +403,4 @@ def _quiet_stdout() -> Iterator[None]:
 def mesh_bytes(mesh) -> bytes:
     """A content key for a palette mesh."""
     return (np.asarray(mesh.vertices).round(4).tobytes() + np.asarray(mesh.faces).tobytes()
-            + np.asarray(mesh.colours).tobytes())
+            + np.asarray(colours(mesh)).tobytes())

@@ -16,13 +16,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import trimesh
+from trimesh.exchange.obj import export_obj
 
 from ravh_sim.world.geometry import triangulate
 from ravh_sim.world.house import Door, House, Room, Wall, Window
+from ravh_sim.world.mesh import uv_visual
 from ravh_sim.world.paints import TEXTURE_TILE_M
 
 LINTEL_OVERLAP = 0.05      # m a lintel reaches into the wall pieces at each of its ends
@@ -77,34 +80,26 @@ def _lengthened(w: Wall, by: float) -> Wall:
     return replace(w, a=(ax - dx, ay - dy), b=(bx + dx, by_ + dy))
 
 
-@dataclass
-class TexturedMesh:
-    vertices: np.ndarray     # (N, 3)
-    uvs: np.ndarray          # (N, 2)
-    normals: np.ndarray      # (N, 3)
-    faces: np.ndarray        # (M, 3) int, counter-clockwise from outside
-
-    @property
-    def triangle_count(self) -> int:
-        return len(self.faces)
-
-    def write_obj(self, path: Path) -> None:
-        lines = [f"v {x:.4f} {y:.4f} {z:.4f}" for x, y, z in self.vertices]
-        lines += [f"vt {u:.4f} {v:.4f}" for u, v in self.uvs]
-        lines += [f"vn {x:.4f} {y:.4f} {z:.4f}" for x, y, z in self.normals]
-        lines += [f"f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}" for a, b, c in self.faces + 1]
-        path.write_text("\n".join(lines) + "\n")
+def textured(vertices: np.ndarray, uvs: np.ndarray, normals: np.ndarray, faces: np.ndarray) -> trimesh.Trimesh:
+    """A painted surface: (N, 3) vertices with (N, 2) texture coordinates (texture tiles) and
+    (N, 3) normals, (M, 3) faces counter-clockwise from outside."""
+    return trimesh.Trimesh(vertices, faces, process=False, vertex_normals=normals, visual=uv_visual(uvs))
 
 
-def merge(meshes: list[TexturedMesh]) -> TexturedMesh:
+def write_textured_obj(mesh: trimesh.Trimesh, path: Path) -> None:
+    """The surface as an OBJ file for pybullet's renderer (trimesh's writer, 4 decimals)."""
+    path.write_text(export_obj(mesh, include_normals=True, digits=4, header=None))
+
+
+def merge(meshes: list[trimesh.Trimesh]) -> trimesh.Trimesh:
     offsets = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
-    return TexturedMesh(np.concatenate([m.vertices for m in meshes]),
-                        np.concatenate([m.uvs for m in meshes]),
-                        np.concatenate([m.normals for m in meshes]),
-                        np.concatenate([m.faces + o for m, o in zip(meshes, offsets)]))
+    return textured(np.concatenate([m.vertices for m in meshes]),
+                    np.concatenate([m.visual.uv for m in meshes]),
+                    np.concatenate([m.vertex_normals for m in meshes]),
+                    np.concatenate([m.faces + o for m, o in zip(meshes, offsets)]))
 
 
-def floor_mesh(room: Room, z: float, facing_up: bool = True) -> TexturedMesh:
+def floor_mesh(room: Room, z: float, facing_up: bool = True) -> trimesh.Trimesh:
     """The room's floor outline(s) as a horizontal surface at height ``z``."""
     parts = []
     for poly in (room.floor, *room.extra_floors):
@@ -114,11 +109,11 @@ def floor_mesh(room: Room, z: float, facing_up: bool = True) -> TexturedMesh:
             tris = tris[:, ::-1]
         verts = np.column_stack([pts, np.full(len(pts), z)])
         normal = np.tile([0.0, 0.0, 1.0 if facing_up else -1.0], (len(pts), 1))
-        parts.append(TexturedMesh(verts, pts / TEXTURE_TILE_M, normal, tris))
+        parts.append(textured(verts, pts / TEXTURE_TILE_M, normal, tris))
     return merge(parts)
 
 
-def wall_mesh(walls: list[Wall], windows: Sequence[Window] = ()) -> TexturedMesh:
+def wall_mesh(walls: list[Wall], windows: Sequence[Window] = ()) -> trimesh.Trimesh:
     """Every wall piece of a room as a box, the texture running along each wall, with a real
     opening where a window sits in it (the window model fills the opening; the outdoors shows
     through its glass)."""
@@ -174,13 +169,13 @@ def _cut_windows(wall: Wall, windows: list[Window]) -> list[Wall]:
     return out
 
 
-def _wall_box(w: Wall) -> TexturedMesh:
+def _wall_box(w: Wall) -> trimesh.Trimesh:
     (ax, ay), (bx, by) = w.a, w.b
     length = max(math.hypot(bx - ax, by - ay), 1e-3)
     d = np.array([(bx - ax) / length, (by - ay) / length])
     n = np.array([-d[1], d[0]]) * w.thickness / 2
     base = [np.array([ax, ay]) - n, np.array([bx, by]) - n, np.array([bx, by]) + n, np.array([ax, ay]) + n]
-    faces: list[TexturedMesh] = []
+    faces: list[trimesh.Trimesh] = []
     for k in range(4):                                   # the four vertical sides
         p, q = base[k], base[(k + 1) % 4]
         edge = q - p
@@ -195,8 +190,8 @@ def _wall_box(w: Wall) -> TexturedMesh:
     return merge(faces)
 
 
-def _quad(corners: list[tuple], uvs_m: list[tuple], normal: tuple) -> TexturedMesh:
+def _quad(corners: list[tuple], uvs_m: list[tuple], normal: tuple) -> trimesh.Trimesh:
     """Two triangles; ``uvs_m`` in metres (scaled to texture tiles here)."""
     verts = np.array(corners, dtype=float)
     uv = np.array(uvs_m, dtype=float) / TEXTURE_TILE_M
-    return TexturedMesh(verts, uv, np.tile(normal, (4, 1)), np.array([[0, 1, 2], [0, 2, 3]]))
+    return textured(verts, uv, np.tile(normal, (4, 1)), np.array([[0, 1, 2], [0, 2, 3]]))
