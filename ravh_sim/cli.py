@@ -55,8 +55,11 @@ def main(argv: list[str] | None = None) -> int:
 
 # ---------------------------------------------------------------------------- helpers
 
+HOUSE_HELP = "house: number (1..30, or an imported home's), imported home's name, or path of a house file"
+
+
 def _world_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("house", type=int, help="house number (1..30)")
+    p.add_argument("house", help=HOUSE_HELP)
     p.add_argument("--seed", type=int, default=None, help="seed for every random choice (default: config)")
     p.add_argument("--config", type=Path, default=None, help="settings YAML (see config/default.yaml)")
 
@@ -93,12 +96,31 @@ def cmd_import_furniture(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_import_home(args: argparse.Namespace) -> int:
+    from ravh_sim.importers.home import import_home
+    from ravh_sim.paths import user_houses_dir
+    out = args.out or user_houses_dir()
+    done = import_home(args.src, out, args.name, args.level)
+    if done.levels:
+        print(f"levels: {', '.join(done.levels)}; imported: {done.level}")
+    counts = ", ".join(f"{v} {k}" for k, v in done.counts.items())
+    print(f"imported {args.src} as house {done.number} {done.name!r} in {done.seconds:.1f} s: {counts}")
+    for what, count in done.left_out.items():
+        print(f"  left out: {what}" + (f" ({count})" if count > 1 else ""))
+    for name, x, y, yaw in done.views:
+        print(f"  stored view {name!r}: --pose {x} {y} {yaw}")
+    print(f"wrote {done.path}; try: ravh plan {done.name} -o plan.png")
+    return 0
+
+
 def cmd_houses(args: argparse.Namespace) -> int:
-    from ravh_sim.world.house import available_houses, load_house
+    from ravh_sim.world.house import available_houses, imported_houses, load_house
     rows: list[dict[str, Any]] = []
-    for n in available_houses():
+    every: list[int | str] = [*available_houses(), *imported_houses()]
+    for n in every:
         h = load_house(n)
-        rows.append({"house": n, "rooms": len(h.rooms), "objects": len(h.objects),
+        named = {"name": h.name} if h.name else {}
+        rows.append({"house": h.number, **named, "rooms": len(h.rooms), "objects": len(h.objects),
                      "doors": len(h.doors), "windows": len(h.windows), "lights": len(h.lights),
                      "rooms_by_type": dict(sorted(Counter(r.type for r in h.rooms).items())),
                      "objects_by_type": dict(sorted(Counter(o.type for o in h.objects).items()))})
@@ -181,7 +203,8 @@ def cmd_render(args: argparse.Namespace) -> int:
     from ravh_sim.world.appearance import Appearance
     from ravh_sim.world.scene import World
     house, resolved = _resolved(args)
-    house.room_at_or_raise(*args.pose[:2])           # an all-sky picture from outside helps nobody
+    pose = args.pose or (*house.station.position[:2], house.station.yaw)     # default: the robot's start
+    house.room_at_or_raise(*pose[:2])                # an all-sky picture from outside helps nobody
     with World(house, resolved, renderer=resolve_backend(args.renderer)) as world:
         appearance = Appearance(world)
         if args.sun is not None:
@@ -189,7 +212,7 @@ def cmd_render(args: argparse.Namespace) -> int:
         if args.lights is not None:
             appearance.set_lights("all", args.lights, args.seed)
         camera = SmartCamera(world, load_profile(args.profile).camera)
-        paths = write_capture(camera, camera.capture(*args.pose), args.output)
+        paths = write_capture(camera, camera.capture(*pose), args.output)
     print("wrote " + ", ".join(str(p) for p in paths))
     return 0
 
@@ -216,13 +239,13 @@ def cmd_raid(args: argparse.Namespace) -> int:
     from ravh_sim.raids.outcome import Outcome
     from ravh_sim.raids.raid import run_raid
     from ravh_sim.world.house import available_houses, load_house
-    houses = available_houses() if args.all else [args.house]
+    houses: list[int | str] = list(available_houses()) if args.all else [args.house]
     if not args.all:
         load_house(args.house)                        # unknown house: the usual clear error
     signal.signal(signal.SIGINT, _interrupt_once)
     results = []
     for house in houses:
-        out = args.out / f"house{house:02d}_raid{args.raid}" if args.all else args.out
+        out = args.out / f"house{int(house):02d}_raid{args.raid}" if args.all else args.out
         results.append(run_raid(house, args.raid, out, fast=args.fast, seed=args.seed,
                                 max_captures=args.max_captures, max_nodes=args.max_nodes))
         if Outcome.of(results[-1]["status"]) is Outcome.INTERRUPTED:       # Ctrl-C ends --all too
@@ -241,7 +264,9 @@ def _interrupt_once(signum: int, frame: Any) -> None:
 
 def cmd_bench(args: argparse.Namespace) -> int:
     from ravh_sim import bench
-    result = bench.run(args.what, houses=args.houses)
+    from ravh_sim.world.house import house_number
+    houses = [house_number(h) for h in args.houses] if args.houses else None     # names -> numbers
+    result = bench.run(args.what, houses=houses)
     if args.json:
         print(json.dumps(result, indent=1))
     else:
@@ -280,6 +305,15 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("-q", "--quiet", action="store_true", help="no line per model")
     p.set_defaults(func=cmd_import_furniture)
 
+    p = sub.add_parser("import-home", help="import a Sweet Home 3D home (.sh3d) as a house of ours")
+    p.add_argument("src", type=Path, help="the .sh3d file")
+    p.add_argument("--name", default=None, help="the house's name (default: from the file name, and the level)")
+    p.add_argument("--level", default=None,
+                   help="the level to import, by name, id or index from the lowest (default: the lowest with rooms)")
+    p.add_argument("-o", "--out", type=Path, default=None,
+                   help="output folder (default: ~/.local/share/ravh_sim/houses, where names are looked up)")
+    p.set_defaults(func=cmd_import_home)
+
     p = sub.add_parser("houses", help="list the houses with room and object counts")
     p.add_argument("--json", action="store_true", help="machine-readable output")
     p.set_defaults(func=cmd_houses)
@@ -315,8 +349,8 @@ def _parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("render", help="render the robot camera's view: rgb, depth, mask and info.json")
     _world_args(p)
-    p.add_argument("--pose", type=float, nargs=3, metavar=("X", "Y", "YAW"), required=True,
-                   help="robot pose on the floor (m, m, rad)")
+    p.add_argument("--pose", type=float, nargs=3, metavar=("X", "Y", "YAW"), default=None,
+                   help="robot pose on the floor (m, m, rad; default: the robot's start)")
     p.add_argument("--sun", default=None, help="sun angle in degrees, or day, sunset, night (default: config)")
     p.add_argument("--lights", choices=SWITCH, default=None,
                    help="switch every light (default: config); random uses --seed")
@@ -327,7 +361,7 @@ def _parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("gallery", help="contact sheet of one view under the five raid presets and a random look")
-    p.add_argument("house", type=int, help="house number (1..30)")
+    p.add_argument("house", help=HOUSE_HELP)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--pose", type=float, nargs=3, metavar=("X", "Y", "YAW"), default=None,
                    help="robot pose (default: the room-centre view with the most objects)")
@@ -339,7 +373,7 @@ def _parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_gallery)
 
     p = sub.add_parser("raid", help="collect a dataset: sim + behaviour + recorder with a paper preset")
-    p.add_argument("--house", type=int, default=15, help="house number (default 15)")
+    p.add_argument("--house", default="15", help=HOUSE_HELP + " (default 15)")
     p.add_argument("--raid", type=int, default=1, choices=range(5),
                    help="0 grid/day, 1 wanderer/day, 2 random paint+models, 3 sunset, 4 night")
     p.add_argument("--out", type=Path, required=True, help="dataset folder (with --all: parent folder)")
@@ -352,7 +386,8 @@ def _parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("bench", help="measure speed; prints JSON with --json")
     p.add_argument("what", choices=BENCHES, help="what to measure")
-    p.add_argument("--houses", type=int, nargs="*", default=None, help="houses to measure (default: all)")
+    p.add_argument("--houses", nargs="*", default=None,
+                   help="houses to measure, by number or imported home's name (default: all)")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_bench)
 

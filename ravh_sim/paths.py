@@ -6,6 +6,7 @@ every module agrees.
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 _PACKAGE = Path(__file__).resolve().parent
@@ -20,3 +21,11 @@ ROBOTS_DIR = CONFIG_DIR / "robots"
 DEFAULT_CONFIG = CONFIG_DIR / "default.yaml"
 FASTDDS_PROFILE = CONFIG_DIR / "fastdds_large_shm.xml"
 PAPER_DIR = CONFIG_DIR / "paper"                 # the paper's Tables 1-4 as TSV (README there)
+
+
+def user_houses_dir() -> Path:
+    """Where ``ravh import-home`` writes homes by default and where names are looked up:
+    ``$XDG_DATA_HOME/ravh_sim/houses`` (``~/.local/share/ravh_sim/houses``); read at each call, so a
+    test or a user can point it elsewhere."""
+    base = os.environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share")
+    return Path(base) / "ravh_sim" / "houses"

@@ -93,7 +93,7 @@ class Agent:
 class SimRuntime:
     """A running house: physics, agents, sensors, appearance, navigation and ground truth."""
 
-    def __init__(self, house: int | House, config: str | Path | None = None, seed: int | None = None,
+    def __init__(self, house: int | str | House, config: str | Path | None = None, seed: int | None = None,
                  renderer: str = "auto", rates: Mapping[str, float] | None = None,
                  footprint: str | Path | None = None) -> None:
         """``footprint``: rebuild exactly the world a footprint file describes (its house and its

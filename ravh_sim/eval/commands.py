@@ -29,7 +29,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--paper-protocol", action="store_true",
                    help="record one wanderer raid with a random appearance per house (--houses) into --out, "
                         "map it with --mappers and print Table 3's columns beside the paper's")
-    p.add_argument("--houses", default="1-30", help="--paper-protocol: houses, e.g. 1-30 or 20,29")
+    p.add_argument("--houses", default="1-30",
+                   help="--paper-protocol: houses, e.g. 1-30, 20,29 or an imported home's name")
     p.add_argument("--mappers", default="oracle,degraded", help="--paper-protocol: oracle, degraded or both")
     p.add_argument("--seed", type=int, default=0, help="--paper-protocol: seed of the raids and the degraded mapper")
     p.add_argument("--iou", type=float, default=None,
@@ -39,7 +40,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=cmd_eval_semantic_map)
 
     p = which.add_parser("localization", help="appearance-based localization errors, routes x maps (Table 4)")
-    p.add_argument("--house", type=int, default=15, help="house number (default 15)")
+    p.add_argument("--house", default="15", help="house: number or imported home's name (default 15)")
     p.add_argument("--out", type=Path, required=True,
                    help="folder for the recordings (reused when present), table4.json/.txt/.png")
     p.add_argument("--quick", action="store_true", help="CI-sized: 2 short routes, 2 maps of the grid nodes along them")
@@ -94,11 +95,10 @@ def _paper_protocol(args: argparse.Namespace, threshold: float, paper_path: Path
     from ravh_sim.errors import UserError
     from ravh_sim.eval.mappers import MAPPERS
     from ravh_sim.eval.table3 import run_protocol
-    from ravh_sim.raids.build import parse_numbers
-    from ravh_sim.world.house import available_houses
+    from ravh_sim.raids.build import parse_houses
     if args.out is None:
         raise UserError("--paper-protocol needs --out (the raids are recorded there and reused)")
-    houses = parse_numbers(args.houses, available_houses(), "houses")
+    houses = parse_houses(args.houses)
     mappers = [m.strip() for m in args.mappers.split(",") if m.strip()]
     if not mappers or set(mappers) - set(MAPPERS):
         raise UserError(f"--mappers: {args.mappers!r}; valid: {', '.join(MAPPERS)}")
@@ -114,8 +114,8 @@ def cmd_eval_localization(args: argparse.Namespace) -> int:
     from ravh_sim.errors import UserError
     from ravh_sim.eval.table4 import FULL, QUICK, format_table4, run_table4
     from ravh_sim.paper import table4
-    from ravh_sim.world.house import load_house
-    load_house(args.house)                            # unknown house: the usual clear error
+    from ravh_sim.world.house import house_number
+    house = house_number(args.house)                  # by number or name; unknown: the usual clear error
     protocol = replace(QUICK if args.quick else FULL, night_lights=args.night_lights)
     if not args.paper.is_file():
         raise UserError(f"--paper: no such file {args.paper}")
@@ -123,7 +123,7 @@ def cmd_eval_localization(args: argparse.Namespace) -> int:
         table4(args.paper)
     except (KeyError, ValueError) as e:
         raise UserError(f"--paper {args.paper}: not Table 4's columns (config/paper/README.md): {e}") from None
-    doc = run_table4(args.house, args.out, protocol, args.descriptor, args.seed,
+    doc = run_table4(house, args.out, protocol, args.descriptor, args.seed,
                      progress=lambda text: print(text, file=sys.stderr, flush=True), paper=args.paper)
     if args.json:
         print(json.dumps(doc, indent=1))

@@ -19,6 +19,7 @@ import contextlib
 import json
 import multiprocessing
 import os
+import re
 import shutil
 import statistics
 import sys
@@ -73,6 +74,20 @@ def parse_numbers(text: str, valid: Iterable[int], what: str) -> list[int]:
     unknown = sorted(numbers - valid)
     if unknown or not numbers:
         raise UserError(f"--{what}: no such {what} {unknown or text}; valid: {min(valid)}-{max(valid)}")
+    return sorted(numbers)
+
+
+def parse_houses(text: str, what: str = "houses") -> list[int]:
+    """--houses: numbers, ranges ('1-30') and imported homes' names ('studio'), comma-separated, as the
+    sorted house numbers; an unknown number or name is a UserError listing the valid ones."""
+    from ravh_sim.world.house import house_number, house_numbers
+    parts = [part.strip() for part in text.split(",")]
+    ranges = [part for part in parts if re.fullmatch(r"\d+\s*(-\s*\d+)?", part)]
+    names = [part for part in parts if part and part not in ranges]
+    numbers = set(parse_numbers(",".join(ranges), house_numbers(), what)) if ranges else set()
+    numbers.update(house_number(name) for name in names)
+    if not numbers:
+        raise UserError(f"--{what}: {text!r} names no house; give numbers, ranges like 1-30 or imported homes' names")
     return sorted(numbers)
 
 
@@ -385,7 +400,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     dataset = sub.add_parser("dataset", help="build the paper's dataset: many houses and raids at once")
     commands = dataset.add_subparsers(metavar="COMMAND")
     p = commands.add_parser("build", help="every (house, raid) into OUT/houseNN/raidK; resumable")
-    p.add_argument("--houses", default="1-30", help="houses, e.g. 1-30 or 20,29 (default 1-30)")
+    p.add_argument("--houses", default="1-30",
+                   help="houses, e.g. 1-30, 20,29, or with imported homes' names: 1-3,studio (default 1-30)")
     p.add_argument("--raids", default="0-4", help="paper presets 0-4 (default all): 0 grid/day, 1 wanderer/day, "
                    "2 random paint+models, 3 sunset, 4 night")
     p.add_argument("--out", type=Path, required=True, help="dataset folder (shared by the nodes with --ray)")
@@ -421,8 +437,7 @@ def cmd_export(args: argparse.Namespace) -> int:
 
 
 def cmd_build(args: argparse.Namespace) -> int:
-    from ravh_sim.world.house import available_houses
-    houses = parse_numbers(args.houses, available_houses(), "houses")
+    houses = parse_houses(args.houses)
     raids = parse_numbers(args.raids, range(len(PRESETS)), "raids")
 
     def say_redo(name: str, why: str) -> None:

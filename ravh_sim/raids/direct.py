@@ -88,7 +88,7 @@ BehaviourSpec = GridSpec | WandererSpec | PosesSpec
 BEHAVIOURS: dict[str, type] = {"grid": GridSpec, "wanderer": WandererSpec}
 
 
-def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wanderer", *,
+def record(out: str | Path, house: int | str, behaviour: BehaviourSpec | str = "wanderer", *,
            settings: dict[str, Any] | None = None, seed: int | None = None, max_captures: int = 0,
            max_sim_s: float = MAX_SIM_S, raid: dict[str, Any] | None = None, renderer: str = "auto",
            progress: Callable[[int], None] | None = None) -> dict[str, Any]:
@@ -114,7 +114,9 @@ def record(out: str | Path, house: int, behaviour: BehaviourSpec | str = "wander
         layout.atomic_write(settings_path, yaml.safe_dump(settings or {}, sort_keys=False).encode())
         runtime = SimRuntime(house, settings_path, seed, renderer=renderer)
         try:
-            meta = {"house": runtime.house.number, "engine": "direct", "behaviour": _describe(spec),
+            home = runtime.house
+            imported = {"house_name": home.name, "attribution": home.attribution} if home.name else {}
+            meta = {"house": home.number, **imported, "engine": "direct", "behaviour": _describe(spec),
                     "seed": runtime.world.state.seed, **(raid or {})}
             session = _Session(runtime, writer, progress)
             writer.write_meta(runtime.house.number, [session.agent.name], meta)

@@ -34,6 +34,7 @@ from ravh_sim.dataset import layout
 from ravh_sim.errors import UserError
 from ravh_sim.nodes.common import ros_domain_id
 from ravh_sim.raids.outcome import LOSS_SEPARATOR, Outcome
+from ravh_sim.world.house import load_house
 from ravh_sim.world.settings import check_seed
 
 FAST_RTF = 4.0                   # --fast: sim seconds per wall second asked of the sim node
@@ -70,7 +71,7 @@ def preset_settings(preset: RaidPreset, seed: int) -> dict:
             "models": {"all": preset.models}}
 
 
-def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | None = None,
+def run_raid(house: int | str, raid: int, out: Path, fast: bool = False, seed: int | None = None,
              max_captures: int = 0, max_nodes: int = 0, timeout: float = 3600.0, quiet: bool = False,
              meta: dict | None = None) -> dict:
     """Run one raid into the new folder ``out``; returns its summary (also written to ``out/raid.json``).
@@ -78,7 +79,9 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
     if not 0 <= raid < len(PRESETS):
         raise UserError(f"unknown raid {raid}; valid: {', '.join(map(str, range(len(PRESETS))))}")
     preset = PRESETS[raid]
-    seed = check_seed(house * 10 + raid if seed is None else seed)
+    home = load_house(house)                  # by number, name or path (the sim is given the same words)
+    number = home.number
+    seed = check_seed(number * 10 + raid if seed is None else seed)
     logs = out / "logs"
     settings_path = out / "raid_settings.yaml"
     with _writing(out):
@@ -86,7 +89,7 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
             raise UserError(f"{out} exists and is not empty; raid into a new folder")
         logs.mkdir(parents=True)
         layout.atomic_write(settings_path, yaml.safe_dump(preset_settings(preset, seed), sort_keys=False).encode())
-    domain, how = ros_domain_id(os.getpid() * 7 + house * 5 + raid)
+    domain, how = ros_domain_id(os.getpid() * 7 + number * 5 + raid)
     if not quiet:
         print(f"ravh raid: ROS_DOMAIN_ID {domain} ({how})", file=sys.stderr)
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE=os.environ.get("ROS_AUTOMATIC_DISCOVERY_RANGE",
@@ -95,13 +98,14 @@ def run_raid(house: int, raid: int, out: Path, fast: bool = False, seed: int | N
     behaviour_args = (["--order", "once", "--capture-period", "0.5"] if preset.behaviour == "wanderer"
                       else ["--captures", "10", "--max-nodes", str(max_nodes)])
     start = time.monotonic()
-    raid_meta = {"house": house, "raid": raid, "preset": preset.__dict__, "seed": seed, "fast": fast,
+    imported = {"house_name": home.name, "attribution": home.attribution} if home.name else {}
+    raid_meta = {"house": number, **imported, "raid": raid, "preset": preset.__dict__, "seed": seed, "fast": fast,
                  "ros_domain_id": domain, **(meta or {})}
     captures, given = out / layout.CAPTURES_JSONL, logs / "behaviour_captures.jsonl"
     status = Outcome.DONE.status()
     sim = recorder = behaviour = None
     wind_down = ExitStack()
-    progress = tqdm(total=max_captures or None, unit="capture", desc=f"house {house} raid {raid}",
+    progress = tqdm(total=max_captures or None, unit="capture", desc=f"{home.title} raid {raid}",
                     disable=quiet, file=sys.stderr, leave=True)
     with wind_down, progress:
         try:

@@ -459,10 +459,13 @@ class _Painter:
 
     def title(self, title: str | None, doors: Mapping[str, bool]) -> None:
         h = self.house
-        text = title or f"House {h.number} — {len(h.rooms)} rooms, {len(h.objects)} objects"
+        name = f"House {h.number} ({h.name})" if h.name else f"House {h.number}"
+        text = title or f"{name} — {len(h.rooms)} rooms, {len(h.objects)} objects"
         _figure_text(self.figure, MARGIN, 46, text, 19, TEXT_RGB, weight="bold")
         n_open = sum(doors.values())
-        sub = (f"Robot@VirtualHome house {h.number:02d}   |   {self.f.scale:.0f} px/m   |   "
+        origin = (f"{h.source.get('file', '')}{' ' + h.source['level'] if h.source.get('level') else ''} by "
+                  f"{h.source.get('author') or 'its author'}" if h.name else f"Robot@VirtualHome house {h.number:02d}")
+        sub = (f"{origin}   |   {self.f.scale:.0f} px/m   |   "
                f"doors: {n_open} open, {len(doors) - n_open} closed   |   {len(h.lights)} lights")
         _figure_text(self.figure, MARGIN, 72, sub, 9, SUBTEXT_RGB)
 

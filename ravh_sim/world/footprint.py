@@ -19,6 +19,7 @@ from ravh_sim.files import atomic_write
 from ravh_sim.poses import quaternion_from_yaw
 from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import House
+from ravh_sim.world.library import record
 from ravh_sim.world.settings import Resolved
 from ravh_sim.world.solids import object_parts
 
@@ -80,7 +81,7 @@ def instance_pose(house: House, models: Mapping[str, int], inst: Instance) -> di
     fitted = object_parts(house, obj, model).model
     return {"position": _r(box.position), "orientation": _r(quaternion_from_yaw(obj.yaw)),
             "yaw": _r(obj.yaw), "model": model, "size": _r(box.size),
-            "asset": fitted.model.id if fitted is not None else None}
+            "asset": record(fitted).id if fitted is not None else None}
 
 
 def make_footprint(house: House, settings: Resolved) -> dict[str, Any]:
@@ -96,8 +97,10 @@ def make_footprint(house: House, settings: Resolved) -> dict[str, Any]:
         if inst.name in settings.lights:
             row["on"] = settings.lights[inst.name]
         rows.append(row)
-    return {"format": FOOTPRINT_FORMAT, "house": house.number, "settings": settings.model_dump(mode="json"),
-            "instances": rows}
+    imported = ({"house_name": house.name, "attribution": house.attribution, "source": house.source}
+                if house.name else {})
+    return {"format": FOOTPRINT_FORMAT, "house": house.number, **imported,
+            "settings": settings.model_dump(mode="json"), "instances": rows}
 
 
 def dump_footprint(footprint: dict[str, Any]) -> str:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
@@ -21,9 +22,10 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, Field, model_validator
 
 from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
-from ravh_sim.paths import HOUSES_DIR
+from ravh_sim.paths import HOUSES_DIR, user_houses_dir
 from ravh_sim.schema import Strict, number, read_text, shown, validate, vector
 from ravh_sim.world.geometry import Polygon, distance_to_polygon, point_in_polygon, polygon_area, self_intersection
+from ravh_sim.world.paints import is_paint
 
 HOUSE_FORMAT = "ravh_sim/house@1"
 LIGHT_KINDS = ("ceiling", "lamp", "wall")
@@ -42,6 +44,11 @@ class Room:
     extra_floors: tuple[Polygon, ...]
     floor_z: float
     ceiling_z: float
+    paint: tuple[tuple[str, str], ...] = ()    # the room's own paint by surface (an imported home's colours)
+
+    def own_paint(self, surface: str) -> str | None:
+        """The paint the house file gives this room's ``surface`` (walls, floor), or None."""
+        return dict(self.paint).get(surface)
 
     @property
     def area(self) -> float:
@@ -123,6 +130,7 @@ class HouseObject:
     models: tuple[ModelBox, ...]   # one per upstream model variant
     default_model: int
     inherits_model_from: str | None
+    own_model: Path | None = None  # the house's own model (variant 0), an npz beside the house file
 
     def box(self, model: int | None) -> ModelBox:
         """The box of model variant ``model`` (variants beyond upstream's use the default box)."""
@@ -149,6 +157,13 @@ class House:
     objects: tuple[HouseObject, ...]
     station: Station
     source: dict[str, Any] = field(default_factory=dict, compare=False)
+    name: str = ""                 # an imported home's name (``ravh import-home``); "" for the shipped houses
+    attribution: str = field(default="", compare=False)
+
+    @property
+    def title(self) -> str:
+        """How messages name the house: ``house 15``, or an imported home's name."""
+        return self.name or f"house {self.number}"
 
     @cached_property
     def room_by_id(self) -> dict[str, Room]:
@@ -225,15 +240,46 @@ def available_houses(houses_dir: Path = HOUSES_DIR) -> list[int]:
     return sorted(int(p.stem[5:]) for p in houses_dir.glob("house[0-9][0-9].json"))
 
 
+def imported_houses() -> dict[str, Path]:
+    """The homes ``ravh import-home`` wrote into the user's folder, by name."""
+    folder = user_houses_dir()
+    return {p.stem: p for p in sorted(folder.glob("*.json"))} if folder.is_dir() else {}
+
+
+def resolve_house(house: int | str | Path, houses_dir: Path = HOUSES_DIR) -> Path:
+    """The house file a HOUSE argument names: a number (a shipped house, else an imported home of that
+    number), an imported home's name, or the path of a house file. Every command resolves here."""
+    if isinstance(house, Path):
+        return house
+    text = str(house).strip()
+    if text.isdigit():
+        path = house_path(int(text), houses_dir)
+        if path.exists():
+            return path
+        numbered = {_number_of(p): p for p in imported_houses().values()}
+        if int(text) in numbered:
+            return numbered[int(text)]
+    elif "/" in text or os.sep in text or text.endswith(".json"):
+        return Path(text).expanduser()
+    elif text in imported_houses():
+        return imported_houses()[text]
+    raise UnknownNameError("house", int(text) if text.isdigit() else text,
+                           [*available_houses(houses_dir), *imported_houses()])
+
+
+def _number_of(path: Path) -> int | None:
+    """The ``house`` number of a house file, without validating the rest (None: unreadable)."""
+    try:
+        number = json.loads(read_text(path, "house file", MAX_HOUSE_BYTES)).get("house")
+    except (UserError, ValueError, AttributeError, RecursionError):
+        return None
+    return number if isinstance(number, int) else None
+
+
 def load_house(house: int | str | Path, houses_dir: Path = HOUSES_DIR) -> House:
-    """Load a house by number (1..30) or by file path; errors name the file and field."""
-    if isinstance(house, Path) or (isinstance(house, str) and not house.isdigit()):
-        path = Path(house)
-    else:
-        number = int(house)
-        path = house_path(number, houses_dir)
-        if not path.exists():
-            raise UnknownNameError("house", number, available_houses(houses_dir))
+    """Load a house by number, imported home's name or file path (:func:`resolve_house`); errors name
+    the file and field."""
+    path = resolve_house(house, houses_dir)
     text = read_text(path, "house file", MAX_HOUSE_BYTES)
     try:
         data = json.loads(text)
@@ -246,6 +292,27 @@ def load_house(house: int | str | Path, houses_dir: Path = HOUSES_DIR) -> House:
     if named and int(named[1]) != loaded.number:
         raise FileFieldError(path, "house", f"{loaded.number} disagrees with the file name {path.name}")
     return loaded
+
+
+def house_number(house: int | str | Path, houses_dir: Path = HOUSES_DIR) -> int:
+    """The number of the house a HOUSE argument names, for what keys houses by number (a dataset
+    build's folders and seeds, the evaluations, the benches). The file is loaded (a bad one fails
+    here), and a house file outside both folders is refused: its number would not find it again."""
+    loaded = load_house(house, houses_dir)
+    try:
+        found = resolve_house(loaded.number, houses_dir)
+    except UnknownNameError:
+        found = None
+    if found is None or found.resolve() != resolve_house(house, houses_dir).resolve():
+        raise UserError(f"{house}: this command takes a house by number or by an imported home's name; "
+                        f"import a home with 'ravh import-home' first")
+    return loaded.number
+
+
+def house_numbers(houses_dir: Path = HOUSES_DIR) -> list[int]:
+    """The numbers of every house: the shipped ones and the imported homes'."""
+    imported = (_number_of(p) for p in imported_houses().values())
+    return sorted({*available_houses(houses_dir), *(n for n in imported if n is not None)})
 
 
 # bounds that no real house comes near, so a unit or typing slip (1e12, 1e30) is refused at load
@@ -267,6 +334,26 @@ P2 = vector(Coord, 2)
 P3 = vector(Coord, 3)
 
 
+def _not_a_number(name: str) -> str:
+    if name.isdigit():
+        raise ValueError("a name must not be all digits (digits name a house by number)")
+    return name
+
+
+def _inside(path: str) -> str:
+    if ".." in path.split("/"):
+        raise ValueError("must stay in the house file's folder (no '..')")
+    return path
+
+
+# an imported home's name: lower case, not all digits
+HouseName = Annotated[str, Field(min_length=1, max_length=60, pattern=r"^[a-z0-9][a-z0-9_-]*$"),
+                      AfterValidator(_not_a_number)]
+# an object's own model: an npz in a folder beside the house file (relative, no '..')
+ModelFile = Annotated[str, Field(max_length=200, pattern=r"^[A-Za-z0-9_-][A-Za-z0-9_./-]*\.npz$"),
+                      AfterValidator(_inside)]
+
+
 MIN_FLOOR_AREA = 1e-4      # m^2
 
 
@@ -282,6 +369,17 @@ def _simple_polygon(points: list) -> list:
 FloorOutline = Annotated[list[P2], Field(min_length=3, max_length=MAX_OUTLINE), AfterValidator(_simple_polygon)]
 
 
+def _paint(value: str) -> str:
+    if not is_paint(value):
+        raise ValueError(f"not a paint (a name of ravh_sim/world/paints.py or #rrggbb): {shown(value)}")
+    return value
+
+
+class _RoomPaint(Strict):
+    walls: Annotated[str, AfterValidator(_paint)] | None = None
+    floor: Annotated[str, AfterValidator(_paint)] | None = None
+
+
 class _Room(Strict):
     id: Id
     type: Id
@@ -290,6 +388,7 @@ class _Room(Strict):
     extra_floors: Annotated[list[FloorOutline], Field(max_length=16)] = []
     floor_z: Coord
     ceiling_z: Coord
+    paint: _RoomPaint | None = None
 
     @model_validator(mode="after")
     def _ceiling_above_floor(self) -> _Room:
@@ -370,6 +469,7 @@ class _Object(Strict):
     default_model: Annotated[int, Field(ge=0)]
     models: Annotated[list[_ModelBox], Field(min_length=1, max_length=16)]
     inherits_model_from: Id | None = None
+    model_file: ModelFile | None = None
 
     @model_validator(mode="after")
     def _consistent(self) -> _Object:
@@ -391,6 +491,7 @@ class HouseFile(Strict):
     """The schema of a house file (houses/README.md); cross-references are checked after it."""
     format: Literal[HOUSE_FORMAT]
     house: Annotated[int, Field(ge=1, le=99)]
+    name: HouseName | None = None
     attribution: str = ""
     source: dict[str, str] = {}
     station: _Station
@@ -429,7 +530,10 @@ def house_from_dict(data: Any, source: str) -> House:
             refs.room(f"{kind}[{i}].room", item.room)
     refs.object("station.object_id", f.station.object_id)
     rooms = tuple(Room(r.id, r.type, r.name, _poly(r.floor), tuple(_poly(p) for p in r.extra_floors),
-                       r.floor_z, r.ceiling_z) for r in f.rooms)
+                       r.floor_z, r.ceiling_z,
+                       tuple((k, v) for k, v in (r.paint.model_dump() if r.paint else {}).items() if v))
+                  for r in f.rooms)
+    folder = Path(source).parent
     house = House(
         number=f.house, rooms=rooms,
         walls=tuple(Wall(w.a, w.b, w.thickness, w.z0, w.z1, w.room, w.kind) for w in f.walls),
@@ -439,9 +543,9 @@ def house_from_dict(data: Any, source: str) -> House:
                       for w in f.windows),
         lights=tuple(Light(lt.id, lt.kind, lt.position, lt.intensity, lt.range, lt.color, lt.room)
                      for lt in f.lights),
-        objects=tuple(_object(o) for o in f.objects),
+        objects=tuple(_object(o, source, i, folder) for i, o in enumerate(f.objects)),
         station=Station(f.station.position, f.station.yaw, f.station.object_id),
-        source=dict(f.source))
+        source=dict(f.source), name=f.name or "", attribution=f.attribution)
     x, y, _ = house.station.position
     if house.room_at(x, y) is None:
         raise FileFieldError(source, "station.position", "outside every room")
@@ -493,13 +597,18 @@ def _poly(points: list) -> Polygon:
     return tuple(tuple(p) for p in points)
 
 
-def _object(o: _Object) -> HouseObject:
+def _object(o: _Object, source: str, index: int, folder: Path) -> HouseObject:
     models = tuple(ModelBox(m.position, m.size) for m in o.models)
     default = models[o.default_model]
+    own = None
+    if o.model_file is not None:
+        own = folder / o.model_file
+        if not own.is_file():
+            raise FileFieldError(source, f"objects[{index}].model_file", f"no such file: {own}")
     return HouseObject(id=o.id, type=o.type, tags=tuple(o.tags), room=o.room, prefab=o.prefab,
                        position=default.position, yaw=o.yaw, size=default.size,
                        size_estimated=o.size_estimated, models=models, default_model=o.default_model,
-                       inherits_model_from=o.inherits_model_from)
+                       inherits_model_from=o.inherits_model_from, own_model=own)
 
 
 def _unique(source: str, name: str, ids: list[str]) -> set[str]:

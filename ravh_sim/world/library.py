@@ -30,23 +30,24 @@ Glass, decided here once for every sensor:
   in its collider, ``World._model_collision``), the renderer draws it into the depth and instance
   images (dark, glossy, with nothing seen through it: :func:`ravh_sim.look.materials.library_material`).
 
-So the laser and the depth image never disagree about glass: both read :attr:`LibraryModel.faces`,
+So the laser and the depth image never disagree about glass: both read a model's ``faces``,
 glass faces included, and nothing else.
 """
 from __future__ import annotations
 
 import functools
 import re
-from dataclasses import dataclass
+from pathlib import Path
 from typing import Literal
 
 import numpy as np
 import trimesh
 from pydantic import Field
 
+from ravh_sim.errors import UserError
 from ravh_sim.paths import FURNITURE_DIR
 from ravh_sim.schema import Strict
-from ravh_sim.world.mesh import Mesh
+from ravh_sim.world.mesh import coloured, uv_visual
 from ravh_sim.world.palette import PALETTE
 
 CATALOG_FORMAT = "ravh_sim/furniture@1"
@@ -129,43 +130,35 @@ class LibraryCatalog(Strict):
     models: list[LibraryRecord]
 
 
-@dataclass(frozen=True)
-class LibraryModel:
-    """A library model's triangles in its own frame (centred box, z up, front along +x)."""
-    record: LibraryRecord
-    vertices: np.ndarray              # (N, 3) float64
-    faces: np.ndarray                 # (M, 3) int64
-    uvs: np.ndarray                   # (N, 2) float32
-    face_material: np.ndarray         # (M,) int64
-    face_piece: np.ndarray            # (M,) int64
-
-    @property
-    def id(self) -> str:
-        return self.record.id
-
-    @property
-    def materials(self) -> list[LibraryMaterial]:
-        return self.record.materials
-
-    @property
-    def glass_faces(self) -> np.ndarray:
-        """(M,) bool: the faces of glass materials (:func:`is_glass`), which collide and are drawn
-        like every other face."""
-        glass = np.array([is_glass(m) for m in self.materials], bool)
-        return glass[self.face_material] if len(glass) else np.zeros(len(self.faces), bool)
+def record(model: trimesh.Trimesh) -> LibraryRecord:
+    """What the catalogue says of a library model (loaded or fitted)."""
+    return model.metadata["record"]
 
 
-@dataclass(frozen=True)
-class FittedModel:
-    """A library model placed in an object's body frame (the box centred at the origin)."""
-    model: LibraryModel
-    vertices: np.ndarray              # (N, 3) in the body frame
+def face_material(model: trimesh.Trimesh) -> np.ndarray:
+    """(M,) each face's material, an index into ``record(model).materials``."""
+    return model.face_attributes["material"]
 
-    @property
-    def mesh(self) -> trimesh.Trimesh:
-        """Every triangle of the model, glass included: what the laser collides with and what the
-        camera draws."""
-        return trimesh.Trimesh(self.vertices, self.model.faces, process=False)
+
+def glass_faces(model: trimesh.Trimesh) -> np.ndarray:
+    """(M,) bool: the faces of glass materials (:func:`is_glass`), which collide and are drawn
+    like every other face."""
+    glass = np.array([is_glass(m) for m in record(model).materials], bool)
+    return glass[face_material(model)] if len(glass) else np.zeros(len(model.faces), bool)
+
+
+def _model(entry: LibraryRecord, vertices: np.ndarray, faces: np.ndarray, uvs: np.ndarray,
+           attributes: dict[str, np.ndarray]) -> trimesh.Trimesh:
+    """A library model's triangles: its record in ``metadata``, its material and piece per face
+    in ``face_attributes``, its texture coordinates in a ``TextureVisuals``."""
+    return trimesh.Trimesh(vertices, faces, process=False, face_attributes=attributes, visual=uv_visual(uvs),
+                           metadata={"record": entry})
+
+
+def with_vertices(model: trimesh.Trimesh, vertices: np.ndarray) -> trimesh.Trimesh:
+    """The model with its vertices moved (fitted into an object's box, in the body frame): every
+    triangle, glass included, is what the laser collides with and what the camera draws."""
+    return _model(record(model), vertices, model.faces, model.visual.uv, model.face_attributes)
 
 
 _PREFAB_CLASSES: tuple[tuple[str, str, str], ...] = (
@@ -206,12 +199,36 @@ def models_of(kind: str) -> tuple[LibraryRecord, ...]:
 
 
 @functools.lru_cache(maxsize=256)
-def load_model(model_id: str) -> LibraryModel:
-    record = next(r for r in catalog().models if r.id == model_id)
+def load_model(model_id: str) -> trimesh.Trimesh:
+    """A library model in its own frame (centred box, z up, front along +x)."""
+    found = next(r for r in catalog().models if r.id == model_id)
     with np.load(FURNITURE_DIR / "models" / f"{model_id}.npz") as data:
-        return LibraryModel(record, data["vertices"].astype(np.float64), data["faces"].astype(np.int64),
-                            data["uvs"].astype(np.float32), data["face_material"].astype(np.int64),
-                            data["face_piece"].astype(np.int64))
+        return _model(found, data["vertices"].astype(np.float64), data["faces"].astype(np.int64),
+                      data["uvs"].astype(np.float32), {"material": data["face_material"].astype(np.int64),
+                                                       "piece": data["face_piece"].astype(np.int64)})
+
+
+@functools.lru_cache(maxsize=256)
+def load_model_file(path: Path) -> trimesh.Trimesh:
+    """A house's own model (``ravh import-home``): a library model's arrays and its ``record`` (JSON) in
+    one npz, its textures in the npz's folder (their paths made absolute here, which the renderer reads
+    as they are). Indices are checked: the file came from a user's folder."""
+    try:
+        with np.load(path) as data:
+            found = LibraryRecord.model_validate_json(str(data["record"]))
+            vertices, faces = data["vertices"].astype(np.float64), data["faces"].astype(np.int64)
+            uvs, materials = data["uvs"].astype(np.float32), data["face_material"].astype(np.int64)
+            pieces = data["face_piece"].astype(np.int64)
+    except (OSError, KeyError, ValueError) as e:
+        raise UserError(f"{path}: not a model file of ravh import-home: {str(e)[:200]}") from None
+    if (faces.ndim != 2 or faces.shape[1] != 3 or not len(faces) or faces.min() < 0 or faces.max() >= len(vertices)
+            or len(uvs) != len(vertices) or len(materials) != len(faces) or len(pieces) != len(faces)
+            or materials.max() >= len(found.materials)):
+        raise UserError(f"{path}: inconsistent model arrays")
+    textured = [m if m.texture is None else m.model_copy(update={"texture": str(path.parent / m.texture)})
+                for m in found.materials]
+    return _model(found.model_copy(update={"materials": textured}), vertices, faces, uvs,
+                  {"material": materials, "piece": pieces})
 
 
 def fit_scale(natural: np.ndarray, size: np.ndarray) -> np.ndarray:
@@ -231,7 +248,7 @@ def misfit(natural: np.ndarray, size: np.ndarray) -> float:
     return float(ratio.max() - ratio.min())
 
 
-def fit(model: LibraryModel, size: np.ndarray) -> np.ndarray:
+def fit(model: trimesh.Trimesh, size: np.ndarray) -> np.ndarray:
     """The model's vertices scaled into a box of ``size`` (front, across, up) centred at the origin
     (:func:`fit_scale`), standing on the box's floor with its back against the box's back
     (x = -size/2), centred across."""
@@ -265,9 +282,9 @@ def piece_labels(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return np.unique(roots[corner[:, 0]], return_inverse=True)[1].reshape(-1)
 
 
-def palette_stand_in(fitted: FittedModel) -> Mesh:
+def palette_stand_in(fitted: trimesh.Trimesh) -> trimesh.Trimesh:
     """The fitted model coloured with the nearest palette colour of each material: what pybullet's
     TinyRenderer fallback draws (it knows one texture per body, not a model's textures)."""
-    srgb = np.array([m.colour if m.texture is None else _TEXTURE_STAND_IN for m in fitted.model.materials])
+    srgb = np.array([m.colour if m.texture is None else _TEXTURE_STAND_IN for m in record(fitted).materials])
     nearest = np.argmin(np.linalg.norm(PALETTE.rgb[None, :, :] - srgb[:, None, :], axis=2), axis=1)
-    return Mesh(fitted.vertices, fitted.model.faces, nearest[fitted.model.face_material])
+    return coloured(fitted.vertices, fitted.faces, nearest[face_material(fitted)])

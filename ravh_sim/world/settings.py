@@ -27,7 +27,7 @@ from ravh_sim.errors import FileFieldError, UnknownNameError, UserError
 from ravh_sim.paths import DEFAULT_CONFIG, ROBOTS_DIR
 from ravh_sim.schema import Strict, load_yaml, read_text, shown, validate
 from ravh_sim.world import paints
-from ravh_sim.world.house import House, HouseObject, Light
+from ravh_sim.world.house import House, HouseObject, Light, Room
 from ravh_sim.world.solids import model_count
 
 DOOR_STATES = ("default", *DOOR)          # a settings file may also keep a door as the house has it
@@ -249,14 +249,14 @@ def _resolve_paint(cfg: dict, house: House, pick: _Picker, source: str) -> dict[
         surfaces = {}
         for surface, general in (("walls", "walls"), ("floor", "floors")):
             value = (per_room.get(room.id) or {}).get(surface) or cfg[general]
-            surfaces[surface] = _paint(value, room.type, surface, pick.rng("paint", f"{room.id}/{surface}"))
+            surfaces[surface] = _paint(value, room, surface, pick.rng("paint", f"{room.id}/{surface}"))
         out[room.id] = surfaces
     return out
 
 
-def _paint(value: str, room_type: str, surface: str, rng: random.Random) -> str:
-    if value == "default":
-        return paints.default_paint(room_type, surface)
+def _paint(value: str, room: Room, surface: str, rng: random.Random) -> str:
+    if value == "default":              # the room's own paint (an imported home's colours), else by its type
+        return room.own_paint(surface) or paints.default_paint(room.type, surface)
     if value == "random":
         return rng.choice(paints.all_paints())
     if value == "random_plain":

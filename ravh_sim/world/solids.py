@@ -19,6 +19,7 @@ import functools
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import trimesh
@@ -28,7 +29,7 @@ from ravh_sim.world import library
 from ravh_sim.world.facing import choose_facing, front_axis, suits_box
 from ravh_sim.world.furniture import build_parts, variant_count
 from ravh_sim.world.house import Door, House, HouseObject
-from ravh_sim.world.mesh import Mesh, box
+from ravh_sim.world.mesh import box, merged
 from ravh_sim.world.palette import PALETTE
 from ravh_sim.world.structure import doorway_ends
 
@@ -46,16 +47,16 @@ Footprint = tuple[tuple[float, float], tuple[float, float], float]
 class Placed:
     """An object's model in its body frame and the body's pose in the house: procedural convex
     ``parts``, or a fitted library ``model`` (then ``parts`` is empty)."""
-    parts: tuple[Mesh, ...]
+    parts: tuple[trimesh.Trimesh, ...]
     bounds: np.ndarray                     # (pieces, 2, 3): each part's (or model piece's) min and max corner
     position: tuple[float, float, float]
     yaw: float
-    model: library.FittedModel | None = None
+    model: trimesh.Trimesh | None = None     # a library model, fitted (library.with_vertices)
     front: float | None = None             # heading of a library model's front in the house frame
 
-    def mesh(self) -> Mesh:
+    def mesh(self) -> trimesh.Trimesh:
         """The procedural parts merged: what the camera draws of them."""
-        return Mesh.merged(self.parts)
+        return merged(self.parts)
 
     def extent(self) -> tuple[np.ndarray, np.ndarray]:
         """(min corner, max corner) of everything the object is, in its body frame."""
@@ -128,12 +129,12 @@ def _convex_hull(points: np.ndarray) -> np.ndarray:
     return corners[:-1] if isinstance(hull, Polygon) else corners
 
 
-def _model_section(fitted: library.FittedModel, z: float) -> np.ndarray:
+def _model_section(fitted: trimesh.Trimesh, z: float) -> np.ndarray:
     """(n, 2, 2) segments where the plane at height ``z`` (body frame) crosses a library model's triangles."""
     heights = fitted.vertices[:, 2]
     if not heights.min() <= z <= heights.max():
         return np.zeros((0, 2, 2))
-    segments = trimesh.intersections.mesh_plane(fitted.mesh, (0.0, 0.0, 1.0), (0.0, 0.0, z))
+    segments = trimesh.intersections.mesh_plane(fitted, (0.0, 0.0, 1.0), (0.0, 0.0, z))
     return np.asarray(segments, np.float64).reshape(-1, 2, 3)[:, :, :2]
 
 
@@ -142,9 +143,14 @@ def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
     if obj.id in house.door_by_id:
         return door_parts(house, house.door_by_id[obj.id], model)
     box = obj.box(model)
+    variant = obj.default_model if model is None else model
+    if obj.own_model is not None:              # variant 0: the house's own model, the others shift by one
+        if variant == 0:
+            fitted, bounds = _own_fitted(obj.own_model, tuple(box.size))
+            return Placed((), bounds, box.position, obj.yaw, fitted, obj.yaw)
+        variant -= 1
     walls = tuple((w.a, w.b) for w in house.walls if w.room == obj.room and w.kind != "lintel")
     facing = _facing(tuple(box.position[:2]), obj.yaw, tuple(box.size), walls, front_axis(obj.type))
-    variant = obj.default_model if model is None else model
     records = library.models_of(library.kind_of(obj.type, obj.prefab))
     if records:
         record, facing = _library_choice(records, variant, np.asarray(box.size), facing, front_axis(obj.type))
@@ -173,8 +179,9 @@ def _library_choice(records: tuple[library.LibraryRecord, ...], variant: int, si
 
 def model_count(obj: HouseObject) -> int:
     """How many models the Object Models setting chooses among for ``obj``: its kind's library
-    models, or the procedural variants of its type."""
-    return len(library.models_of(library.kind_of(obj.type, obj.prefab))) or variant_count(obj.type)
+    models, or the procedural variants of its type, after the house's own model where it has one."""
+    own = obj.own_model is not None
+    return own + (len(library.models_of(library.kind_of(obj.type, obj.prefab))) or variant_count(obj.type))
 
 
 def door_parts(house: House, door: Door, model: int | None) -> Placed:
@@ -188,7 +195,7 @@ def door_parts(house: House, door: Door, model: int | None) -> Placed:
     jambs = tuple(box(((a + b) / 2 * _Y), (DOOR_LEAF_THICKNESS, b - a, height), PALETTE.index(JAMB_COLOUR))
                   for a, b in ((left, -width / 2), (width / 2, right)) if b - a > 1e-4)
     parts = leaf + jambs
-    return Placed(parts, np.array([part.bounds() for part in parts]), *door_pose(house, door))
+    return Placed(parts, np.array([part.bounds for part in parts]), *door_pose(house, door))
 
 
 def door_pose(house: House, door: Door) -> tuple[tuple[float, float, float], float]:
@@ -200,16 +207,16 @@ def door_pose(house: House, door: Door) -> tuple[tuple[float, float, float], flo
 
 @functools.lru_cache(maxsize=8192)
 def _parts(object_type: str, size: tuple[float, float, float], variant: int, facing: int,
-           prefab: str) -> tuple[tuple[Mesh, ...], np.ndarray]:
+           prefab: str) -> tuple[tuple[trimesh.Trimesh, ...], np.ndarray]:
     """The parts and their bounds, cached: the world, every free-space map and every door or model
     change ask again."""
     parts = tuple(build_parts(object_type, np.asarray(size), variant, facing, prefab))
-    return parts, np.array([part.bounds() for part in parts])
+    return parts, np.array([part.bounds for part in parts])
 
 
 @functools.lru_cache(maxsize=1024)
 def _fitted(model_id: str, size: tuple[float, float, float], facing: int
-            ) -> tuple[library.FittedModel, np.ndarray]:
+            ) -> tuple[trimesh.Trimesh, np.ndarray]:
     """A library model fitted into a box (turned to ``facing`` as procedural models are) and the
     boxes of its largest pieces, cached like :func:`_parts`."""
     extents = np.asarray(size, np.float64)
@@ -217,7 +224,17 @@ def _fitted(model_id: str, size: tuple[float, float, float], facing: int
     model = library.load_model(model_id)
     turn = trimesh.transformations.rotation_matrix(facing * np.pi / 2, (0, 0, 1))[:3, :3]
     vertices = library.fit(model, np.array([d, w, h])) @ turn.T
-    return library.FittedModel(model, vertices), _piece_bounds(vertices, model.faces, model.face_piece)
+    return library.with_vertices(model, vertices), _piece_bounds(vertices, model.faces, model.face_attributes["piece"])
+
+
+@functools.lru_cache(maxsize=1024)
+def _own_fitted(path: Path, size: tuple[float, float, float]) -> tuple[trimesh.Trimesh, np.ndarray]:
+    """A house's own model stretched to fill its box exactly, as the home's drawing sizes it (it was
+    drawn for this box and faces the object's yaw), with its pieces' boxes, cached like :func:`_fitted`."""
+    model = library.load_model_file(path)
+    lo, hi = model.vertices.min(axis=0), model.vertices.max(axis=0)
+    vertices = (model.vertices - (lo + hi) / 2) * (np.asarray(size, np.float64) / np.maximum(hi - lo, 1e-9))
+    return library.with_vertices(model, vertices), _piece_bounds(vertices, model.faces, model.face_attributes["piece"])
 
 
 def _piece_bounds(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray) -> np.ndarray:
