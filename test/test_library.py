@@ -13,14 +13,13 @@ import trimesh
 
 from ravh_sim.importers.furniture import (
     ABSOLUTE_BUDGET,
-    MIN_TRIANGLES,
     OVER_BUDGET,
     RULES,
     TEXTURE_TEXELS,
-    TRIANGLE_BUDGET,
     Rule,
     import_furniture,
     read_properties,
+    triangle_budget,
 )
 from ravh_sim.paths import FURNITURE_DIR
 from ravh_sim.world import library
@@ -28,8 +27,10 @@ from ravh_sim.world.furniture import OBJECT_TYPES
 from ravh_sim.world.library import LibraryCatalog, kind_of, models_of
 from ravh_sim.world.solids import model_count, object_parts
 
-FEWER_THAN_THREE = {"Sink": (2, "the catalogues hold two kitchen sinks"),
-                    "Standard/tv": (2, "two TV stands within the triangle budget")}
+FEWER_THAN_THREE = {"Sink": (2, "the catalogues hold two basins with taps that sit on a worktop"),
+                    "Standard/tv": (2, "two TV stands within the triangle budget"),
+                    "KitchenFurniture/stove": (1, "one free-standing cooker: the large range is over even the "
+                                                  "appliance budget, the others were a rice cooker and hobs")}
 """Library kinds of types whose upstream objects come in several model variants (house data) that have
 fewer than three models: how many, and why (each checked to apply)."""
 PROCEDURAL = {"Counter": "a worktop is cut to the units under it", "Door": "a leaf in its doorway",
@@ -191,21 +192,22 @@ def test_attribution_covers_every_shipped_model_with_an_open_licence():
 
 
 def test_asset_set_stays_compact():
-    """The library as shipped: 1.7 MB on disk, and every model within what the importer lets through
-    (its budget by size, x OVER_BUDGET, or ABSOLUTE_BUDGET), but for the kinds named in OVER_BUDGET."""
+    """The library as shipped: 2.4 MB on disk (1.7 MB before the dressing objects and detailed
+    appliances), and every model within what the importer lets through (its kind's budget by size,
+    x OVER_BUDGET, or ABSOLUTE_BUDGET), but for the kinds named in OVER_BUDGET."""
     size = sum(p.stat().st_size for p in FURNITURE_DIR.rglob("*") if p.is_file())
-    assert size < 2.0e6
+    assert size < 2.6e6
     catalog = library.catalog().models
     over = {}
     for record in catalog:
         triangles = len(library.load_model(record.id).faces)
         assert triangles == record.triangles, record.id
-        budget = np.clip(TRIANGLE_BUDGET * max(record.size) / 1.5, MIN_TRIANGLES, TRIANGLE_BUDGET)
+        budget = triangle_budget(RULES[record.kind], max(record.size))
         if triangles > max(OVER_BUDGET * budget, ABSOLUTE_BUDGET):
             over[record.kind] = triangles
     assert over.keys() == OVER_BUDGET_KINDS.keys()
     assert all(triangles <= OVER_BUDGET_KINDS[kind][0] for kind, triangles in over.items()), over
-    assert sum(r.triangles for r in catalog) < 110_000                       # 98k in 144 models
+    assert sum(r.triangles for r in catalog) < 150_000      # 142k in 182 (98k in 144 before dressing)
 
 
 def _back_rise(vertices: np.ndarray, faces: np.ndarray) -> float:

@@ -52,6 +52,13 @@ ABSOLUTE_BUDGET = 1500
 """A model that simplification cannot bring within OVER_BUDGET times its budget, nor under
 ABSOLUTE_BUDGET (thousands of loose pieces), is passed over for the kind's next match; a kind whose
 every match is over keeps its smallest."""
+APPLIANCE_TRIANGLES = 2500
+"""Triangles of an appliance, sink or washbasin whatever its size (see :data:`APPLIANCES`): a house has a
+handful, in one kitchen and its bathrooms, and what names them is small detail (handles, a display, an
+oven window, knobs, taps) that 1,000 triangles decimate away; the catalogues' best ones keep 2,500-3,600."""
+TABLEWARE_TRIANGLES = 400
+"""Least triangles of a small dressing object (tableware, kettles, pans, bottles, plants): at
+MIN_TRIANGLES a pan became a cone and a teapot a box; they are seen close up on tables and worktops."""
 TEXTURE_TEXELS = 256
 """Longest texture side: fabric, wood and labels tile or cover a few hundred pixels in a frame."""
 MAX_PER_TYPE = 4
@@ -64,10 +71,34 @@ INDOOR = ("Bathroom", "Bedroom", "Kitchen", "Living room", "Office", "Lights", "
 
 @dataclass(frozen=True)
 class Rule:
-    """Which catalogue entries model one of our object kinds: a name pattern, categories, exclusions."""
+    """Which catalogue entries model one of our object kinds: a name pattern, categories, exclusions;
+    ``ids`` takes entries by catalogue id whatever their name (a pot the catalogue calls a bowl),
+    ``skip_ids`` passes over entries whose name matches but whose model does not look the part (an oven
+    that reads as a microwave); ``least``/``most`` bound the kind's triangle budget (default
+    MIN_TRIANGLES / TRIANGLE_BUDGET, read when used)."""
     name: str
     categories: tuple[str, ...] = INDOOR
     exclude: str = r"$^"
+    ids: str = r"$^"
+    skip_ids: str = r"$^"
+    least: int | None = None
+    most: int | None = None
+
+
+def triangle_budget(rule: Rule, longest_m: float) -> int:
+    """The triangles a model of ``rule``'s kind is simplified towards: TRIANGLE_BUDGET for 1.5 m or
+    more, a share in proportion below, within the rule's bounds."""
+    least = MIN_TRIANGLES if rule.least is None else rule.least
+    most = TRIANGLE_BUDGET if rule.most is None else rule.most
+    return int(np.clip(TRIANGLE_BUDGET * longest_m / 1.5, least, max(least, most)))
+
+
+def _appliance(name: str, categories: tuple[str, ...] = INDOOR, ids: str = r"$^", skip_ids: str = r"$^") -> Rule:
+    return Rule(name, categories, ids=ids, skip_ids=skip_ids, least=APPLIANCE_TRIANGLES, most=APPLIANCE_TRIANGLES)
+
+
+def _tableware(name: str, ids: str = r"$^", skip_ids: str = r"$^") -> Rule:
+    return Rule(name, ids=ids, skip_ids=skip_ids, least=TABLEWARE_TRIANGLES)
 
 
 RULES: dict[str, Rule] = {
@@ -76,7 +107,7 @@ RULES: dict[str, Rule] = {
     "Bed": Rule(r"^bed\b|^double bed|^iron bed|^captain's bed", ("Bedroom",),
                 exclude=r"side|bunk|loft|child|baby|sofa"),
     "Brush": Rule(r"^toilet brush$|^brush$", ("Bathroom",)),
-    "Burner": Rule(r"cooktop|induction cooker|^hob"),
+    "Burner": _appliance(r"cooktop|induction cooker|^hob|^stove$"),
     "Cabinet": Rule(r"^cupboard$|glass door cabinet|^chest$|filing cabinet", exclude=r"kitchen"),
     "Chair": Rule(r"^chair$|^oak chair$|chair with cushion|^osaka chair", ("Living room", "Kitchen")),
     "Chair/office": Rule(r"chair|armchair", ("Office",), exclude=r"class|child"),
@@ -85,7 +116,7 @@ RULES: dict[str, Rule] = {
     "Decoration": Rule(r"^plant$|little plant|indoor plant|yucca|succulent|spider plant|cactus"),
     "Decoration/vase": Rule(r"^vase$"),
     "Desk": Rule(r"^desk$|wooden desk|^desk table"),
-    "Dishwasher": Rule(r"dishwasher"),
+    "Dishwasher": _appliance(r"dishwasher"),
     "Dresser": Rule(r"^dresser|chest of drawers|drawers cabinet|^chest$", exclude=r"kitchen"),
     "Drying": Rule(r"towel rack|radiator"),
     "KitchenFurniture": Rule(r"^lower cabinet$|^kitchen cabinet$|^drawers cabinet$", ("Kitchen",)),
@@ -93,17 +124,18 @@ RULES: dict[str, Rule] = {
     "KitchenFurniture/corner": Rule(r"lower corner cabinet|^lower cabinet$|^kitchen cabinet$", ("Kitchen",)),
     "KitchenFurniture/corner_upper": Rule(r"upper corner cabinet|upper cabinet", ("Kitchen",)),
     "KitchenFurniture/sink": Rule(r"^sink cabinet$|^lower cabinet$|^kitchen cabinet$", ("Kitchen",)),
-    "KitchenFurniture/stove": Rule(r"^cooker$|^stove$|^oven$", ("Kitchen",)),
+    "KitchenFurniture/stove": _appliance(r"^cooker$|^large stove$", ("Kitchen",),
+                                         skip_ids=r"^Scopia#cooker$"),         # a rice cooker
     "Lamp": Rule(r"^lamp$|little lamp|desk lamp|floor uplight|pedestal vase lamp", ("Lights",)),
     "Laptop": Rule(r"^laptop$|ibook"),
     "Light": Rule(r"ceiling lamp|pendant lamp|hanging light", ("Lights",)),
-    "Microwave": Rule(r"microwave"),
+    "Microwave": Rule(r"microwave"),     # the catalogues' one, over any budget: kept as it was
     "Nightstand": Rule(r"bedside table|night ?stand|night table"),
-    "Oven": Rule(r"^oven$|^small oven$|^double oven$"),
-    "Refrigerator": Rule(r"fridge|refrigerator"),
+    "Oven": _appliance(r"^oven$|^small oven$", skip_ids=r"^eTeks#oven$"),  # a bare box: read as a microwave
+    "Refrigerator": _appliance(r"fridge|refrigerator", skip_ids=r"^eTeks#fridge"),  # plain boxes: "wardrobe"
     "Shelf": Rule(r"^shelves$|^vertical shelves$|wall shelf"),
     "ShowerCabin": Rule(r"^shower$|shower stall|shower cabin"),
-    "Sink": Rule(r"^sink$", ("Kitchen",)),
+    "Sink": _appliance(r"^small lavatory$", ids=r"^Scopia#bathroom4$"),   # a bowl with taps, not a cabinet
     "Sofa": Rule(r"^sofa|^couch$|winchester sofa|burlap sofa|clear sofa|^futon couch",
                  exclude=r"convertible|rattan|corner"),
     "Standard": Rule(r"bookcase|^shelves$"),
@@ -114,10 +146,31 @@ RULES: dict[str, Rule] = {
     "Toilet": Rule(r"toilets? unit|^toilet$"),
     "Towel": Rule(r"^towel$"),
     "Tv": Rule(r"^tv|flat tv|wall flat tv", exclude=r"unit|stand|remote|cabinet"),
-    "Washbasin": Rule(r"washbasin|^basin$|small lavatory|vanity", ("Bathroom",), exclude=r"double"),
-    "WashingMachine": Rule(r"washing machine"),
+    "Washbasin": _appliance(r"^washbasin$", ("Bathroom",),
+                            skip_ids=r"^Scopia#bathroom[13]$"),  # a bare worktop; a unit with its own mirror
+    "WashingMachine": _appliance(r"washing machine|^clothes washer$",
+                                 skip_ids=r"^Blend Swap CC-BY#washing_machine$"),  # decimated to a crumpled box
+    "Dressing/plate": _tableware(r"^plate$|^oval plate$|^plate, glass(es)? and cutlery$"),
+    "Dressing/bowl": _tableware(r"^bowl$|^bowl with salad$", skip_ids=r"^Kator Legaz#bowl$"),  # a pot
+    "Dressing/cup": _tableware(r"^coffee cup$|^coffee mug$|^cup$"),       # glasses: clear, unseen
+    "Dressing/fruit_bowl": _tableware(r"^bowl with fruits$|^apples$"),
+    "Dressing/vase": _tableware(r"^flowers$|^tulips$|^orchids$|^white lily$|^vase$"),
+    "Dressing/pan": _tableware(r"$^", ids=r"^Kator Legaz#bowl$"),        # the large pan simplifies to a cone
+    "Dressing/kettle": _tableware(r"espresso kettle|^teapot$"),            # the kettle ("boiler") to a diamond
+    "Dressing/bottle": _tableware(r"wine bottle|beer bottle|oil servers"),
+    "Dressing/box": _tableware(r"cardboard box$|^gift$"),
+    "Dressing/plant": _tableware(r"^little plant$|^succulent plant$|^bamboo$|^cactus$"),
+    "Dressing/floor_plant": Rule(r"^yucca$|^ficus$|^decorative plant$|^spathiphyllum$",
+                                 ids=r"^Scopia#maceta$|^Blend Swap CC-0#plant$"),
+    "Dressing/towel": Rule(r"^towel$"),
+    "Dressing/rug": Rule(r"oriental rug|round carpet|^bathmat$|^doormat$"),
+    "Dressing/curtain": Rule(r"^curtains?$"),
+    "Dressing/blind": Rule(r"venetian blind|window blind"),
 }
-"""Our object kinds (``Type`` or ``Type/prefab-class``, see :func:`ravh_sim.world.library.kind_of`)."""
+"""Our object kinds (``Type`` or ``Type/prefab-class``, see :func:`ravh_sim.world.library.kind_of`), and
+``Dressing/*``: the small things people leave about (:mod:`ravh_sim.world.dressing`). The catalogues have
+no pillow, duvet, cushion, throw or dish rack, their one book simplifies to 6,000 triangles, and their
+one picture frame is a blank canvas: those dressing kinds have no model."""
 
 
 # --- reading the catalogues --------------------------------------------------------------------
@@ -295,8 +348,9 @@ class Converted:
     budget: int                          # the triangles it was simplified towards
 
 
-def convert(entry: Entry, zf: zipfile.ZipFile) -> Converted:
-    """Read, orient, scale, simplify and texture one catalogue model."""
+def convert(entry: Entry, zf: zipfile.ZipFile, rule: Rule = Rule("")) -> Converted:
+    """Read, orient, scale, simplify (to its kind's :func:`triangle_budget`) and texture one catalogue
+    model."""
     obj = read_obj(zf, entry.model)
     keep_material = np.array([not is_clear_glass(m["d"]) for m in obj.materials], bool)
     keep = keep_material[obj.face_material]
@@ -311,7 +365,7 @@ def convert(entry: Entry, zf: zipfile.ZipFile) -> Converted:
     width, depth, height = entry.size_cm
     target = np.array([depth, width, height]) / 100.0
     vertices = (vertices - (lo + hi) / 2) * (target / np.maximum(hi - lo, 1e-9))
-    budget = int(np.clip(TRIANGLE_BUDGET * target.max() / 1.5, MIN_TRIANGLES, TRIANGLE_BUDGET))
+    budget = triangle_budget(rule, float(target.max()))
     mesh, uvs, face_material = _simplify(vertices, obj.uvs, faces, face_material, budget)
     materials, textures = _materials(obj.materials, np.unique(face_material))
     remap = {old: new for new, old in enumerate(np.unique(face_material))}
@@ -382,11 +436,13 @@ def _small_jpeg(data: bytes) -> bytes | None:
 # --- choosing and writing ----------------------------------------------------------------------
 
 def matches(entries: Sequence[Entry], rules: dict[str, Rule] = RULES) -> dict[str, list[Entry]]:
-    """Per object kind, the catalogue entries whose name and category match its rule, in catalogue
-    order."""
-    return {kind: [e for e in entries if not e.door_or_window and e.category in rule.categories
-                   and re.search(rule.name, e.name.lower()) and not re.search(rule.exclude, e.name.lower())]
-            for kind, rule in rules.items()}
+    """Per object kind, the catalogue entries whose name (or id) and category match its rule, in
+    catalogue order."""
+    def chosen(e: Entry, rule: Rule) -> bool:
+        named = re.search(rule.name, e.name.lower()) and not re.search(rule.exclude, e.name.lower())
+        return (not e.door_or_window and e.category in rule.categories and not re.search(rule.skip_ids, e.id)
+                and bool(named or re.search(rule.ids, e.id)))
+    return {kind: [e for e in entries if chosen(e, rule)] for kind, rule in rules.items()}
 
 
 def import_furniture(archives: Sequence[Path], out: Path, rules: dict[str, Rule] = RULES,
@@ -409,7 +465,7 @@ def import_furniture(archives: Sequence[Path], out: Path, rules: dict[str, Rule]
             for entry in picked:
                 if len(kept) == per_kind:
                     break
-                converted = convert(entry, archives_open[entry.archive])
+                converted = convert(entry, archives_open[entry.archive], rules[kind])
                 if len(converted.mesh.faces) <= max(OVER_BUDGET * converted.budget, ABSOLUTE_BUDGET):
                     kept.append((entry, converted))
                 elif smallest is None or len(converted.mesh.faces) < len(smallest[1].mesh.faces):
