@@ -1,5 +1,6 @@
 """The realistic renderer on fixed scenes: sun shadows and window light, sunset colour, lamps without
-halos, textures, and RGB/depth/instance edges that line up (issue: images that look like photos).
+halos, textures, RGB/depth/instance edges that line up (issue: images that look like photos), and the
+outdoors a window shows: a lit neighbourhood that follows the sun, seeded per house (issue 32).
 
 Every comparison of brightness uses a fixed exposure (the camera in manual mode), so it measures
 the light in the scene, not the auto-exposure's reaction to it.
@@ -12,11 +13,13 @@ from dataclasses import replace
 import cv2
 import numpy as np
 import pytest
-from test_sensors import PROFILE, gl_box_world, restored_appearance
+from test_sensors import PROFILE, _world, gl_box_world, restored_appearance
 
-from ravh_sim.look.lighting import sun_light
+from ravh_sim.look.lighting import outdoors, sun_light
 from ravh_sim.look.materials import noise_volume
 from ravh_sim.sensors.camera import CameraOptions, SmartCamera
+from ravh_sim.world.appearance import Appearance
+from ravh_sim.world.house import load_house
 
 EXPOSURE = CameraOptions(manual_exposure=1.0)
 
@@ -146,3 +149,72 @@ def test_rgb_depth_and_instance_edges_line_up(world, appearance):
     gradient = np.hypot(cv2.Sobel(lum, cv2.CV_64F, 1, 0), cv2.Sobel(lum, cv2.CV_64F, 0, 1))
     strong = cv2.dilate(gradient, np.ones((3, 3), np.uint8))          # within 1 px
     assert (strong[occlusion] > 20).mean() > 0.8                      # colour edges sit on mask edges
+
+
+# ----------------------------------------------------------------------------- the outdoors
+
+VIEW_WINDOW = (3.0, 2.0, math.pi)       # room A's west window, 3 m ahead
+
+
+def _pane(world, cap) -> np.ndarray:
+    """The window's glass pixels of a capture, (N, 3) float."""
+    pane = cap.instance == world.instance("Wall_0").id
+    assert pane.mean() > 0.05
+    return cap.rgb[pane].astype(np.float64)
+
+
+def _ideal(world):
+    """A fixed exposure and no sensor model: no noise, so two captures can be compared byte for byte."""
+    return SmartCamera(world, replace(PROFILE.camera, sensor=None), EXPOSURE)
+
+
+def test_the_window_shows_a_sunlit_neighbourhood_not_a_flat_picture(world, appearance):
+    """By day the glass shows garden and sky with structure (not one colour, not clipped white); the
+    same view is warmer at sunset and dark at night, where a few of the neighbours' windows are lit."""
+    seen = {}
+    for preset in ("day", "sunset", "night"):
+        appearance.set_knob("sun_angle", preset)
+        seen[preset] = _pane(world, _camera(world).capture(*VIEW_WINDOW))
+    day, sunset, night = seen["day"], seen["sunset"], seen["night"]
+    luminance = day @ [0.299, 0.587, 0.114]
+    assert luminance.std() > 25                                       # a picture, not a flat colour
+    assert (day.min(axis=1) >= 250).mean() < 0.05                     # not a white hole either
+    green = (day[:, 1] > day[:, 0] + 10) & (day[:, 1] > day[:, 2] + 10)
+    bluish = day[:, 2] > day[:, 0] + 8
+    assert green.mean() > 0.1 and bluish.mean() > 0.05                # lawn and leaves, sky and shade
+    warmth = lambda px: px[:, 0].mean() / px[:, 2].mean()             # noqa: E731
+    assert warmth(sunset) > 1.3 * warmth(day)
+    assert night.mean() < day.mean() / 4
+    assert np.median(night.mean(axis=1)) < 20
+    lit = (night[:, 0] > 120) & (night[:, 0] > night[:, 2] + 30)     # warm, bright: a lit window
+    assert 0.0 < lit.mean() < 0.2
+
+
+def test_each_house_looks_out_on_its_own_neighbourhood(world, appearance):
+    """The outdoors is seeded by the house: the same house shows the same view byte for byte, another
+    house number with the same rooms and pose a different one."""
+    appearance.set_knob("sun_angle", "day")
+    first = _pane(world, _ideal(world).capture(*VIEW_WINDOW))
+    neighbour = replace(world.house, number=world.house.number + 1)
+    with _world(neighbour, "gl") as other:
+        Appearance(other).set_knob("sun_angle", "day")
+        elsewhere = _pane(other, _ideal(other).capture(*VIEW_WINDOW))
+    again = _pane(world, _ideal(world).capture(*VIEW_WINDOW))
+    assert np.array_equal(first, again)
+    assert np.abs(first - elsewhere).mean() > 10
+    sun = sun_light(100.0)
+    assert outdoors(sun, load_house(15)) == outdoors(sun, load_house(15))
+    assert outdoors(sun, load_house(15)).seed != outdoors(sun, load_house(23)).seed
+
+
+def test_the_outdoors_follows_the_sun():
+    """Light model: the sky is brighter by day than at dusk and at night, its horizon warmer at sunset
+    than at noon while the zenith stays blue, and the neighbours' lamps come on as daylight goes."""
+    noon, dusk, night = (outdoors(sun_light(a)) for a in (100.0, 180.0, 200.0))
+    brightness = lambda c: float(np.mean(c))                          # noqa: E731
+    assert brightness(noon.sky_horizon) > brightness(dusk.sky_horizon) > 10 * brightness(night.sky_horizon)
+    assert dusk.sky_horizon[0] / dusk.sky_horizon[2] > 2 * noon.sky_horizon[0] / noon.sky_horizon[2]
+    assert dusk.sky_zenith[2] > dusk.sky_zenith[0]
+    assert night.sky_zenith[2] > night.sky_zenith[0]                  # a dark blue night, not grey
+    assert brightness(noon.light) > 5 * brightness(night.light)
+    assert brightness(noon.lit_windows) == 0.0 < brightness(dusk.lit_windows) < brightness(night.lit_windows)

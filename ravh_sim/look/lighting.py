@@ -10,12 +10,13 @@ here that :func:`scene_lights` applies.
 
 Light units are arbitrary but consistent (a camera's exposure adapts): the sun gives SUN_IRRADIANCE on
 a surface facing it at noon, a lamp of intensity 1 gives LAMP_POWER / d^2, a window is an area light
-of WINDOW_RADIANCE lighting its own room, and the outdoors seen through it is far brighter than the
-room's walls (OUTDOOR_DAY), so it clips to white as in a photo taken indoors.
+of WINDOW_RADIANCE lighting its own room, and the outdoors seen through it is brighter than the room's
+walls (OUTDOOR_DAY) but keeps its structure, as in an indoor photo with the window in it.
 """
 from __future__ import annotations
 
 import math
+import zlib
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
@@ -37,7 +38,10 @@ HORIZON_LEVEL = 0.6
 NOON_COLOUR: RGB = (1.0, 1.0, 1.0)
 SKY_NOON: RGB = (125, 178, 235)
 SKY_HORIZON: RGB = (240, 150, 95)
-SKY_NIGHT: RGB = (10, 14, 32)
+SKY_NIGHT: RGB = (22, 28, 52)            # the horizon at night: a town's glow
+SKY_NOON_HORIZON: RGB = (200, 220, 240)   # haze: the horizon is paler than the zenith
+SKY_DUSK_ZENITH: RGB = (70, 95, 160)      # the sky overhead stays blue while the horizon glows
+SKY_NIGHT_ZENITH: RGB = (6, 9, 24)
 TWILIGHT_DEG = 15.0                       # how long after sunset (and before sunrise) light fades out
 SUN_SOUTH_TILT = 0.35                     # the sun's arc leans to -y so noon light is not vertical
 MOON_DIRECTION: RGB = (-0.3, 0.4, 0.87)
@@ -47,7 +51,14 @@ HOUSE_KELVIN: float = Looks.model_fields["light_temperature"].default   # of the
 SUN_IRRADIANCE = 9.0                  # noon sun on a surface facing it
 SKY_AMBIENT = 0.18                    # bounced sky light filling a room with generous windows, by day
 WINDOW_RADIANCE = 5.0                 # mean radiance of the outdoors seen through a window, by day
-OUTDOOR_DAY = 8.0                     # the outdoors by day against a room's bounce light
+OUTDOOR_DAY = 2.5                     # the outdoors' level by day against a room's bounce light
+OUTDOOR_DUSK = 0.9                    # ... at sunset (the sky stays bright while rooms darken)
+OUTDOOR_NIGHT = 0.25                  # ... and at night (moon and street light)
+OUTDOOR_SUN = 1.6                     # sunlight on the outdoors' surfaces, against OUTDOOR_DAY
+OUTDOOR_FILL = 1.0                    # the sky's light on them
+SKY_FILL = 0.55                       # the sky's light by day, a share of OUTDOOR_FILL
+LIT_WINDOW = 0.5                      # a neighbour's lit window at night
+GROUND_BELOW_FLOOR = 0.4              # the garden lies this far below the ground floor
 MIN_OPENNESS = 0.25                   # rooms without windows still get light through their doors
 WINDOW_REACH = 6.0                    # window area x this / floor area = fully open room
 LAMP_POWER = 1.0                      # irradiance of an intensity-1 lamp at 1 m
@@ -56,8 +67,6 @@ LAMP_BOUNCE = 0.35                    # share of a lamp's power that comes back 
 FIXTURE_GLOW = 6.0                    # radiance of a switched-on lamp shade or bulb
 MOONLIGHT = 0.12                      # the moon and night sky, as a share of sun_light's night gain
 NIGHT_FLOOR = 0.002                   # ambient that never goes away (moon, street lights)
-GROUND_ALBEDO: RGB = (0.09, 0.16, 0.05)    # grass seen through a window
-FACADE_ALBEDO: RGB = (0.55, 0.5, 0.45)     # the neighbours' walls
 
 
 @dataclass(frozen=True)
@@ -140,29 +149,77 @@ def fixture_glow(lamp: Light) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Outdoors:
-    """The sun and what a window shows (sky, ground, the neighbours' façades), in radiance."""
+    """The sun and what a window shows, in radiance: a sky (zenith to horizon, the sun's glow, clouds lit
+    by ``light``), and a neighbourhood (lawn, hedges, trees, the neighbours' houses on rings around
+    ``site``) that the shader lights with ``light`` and ``fill``; ``seed`` picks this house's
+    neighbourhood."""
     sun_direction: RGB
-    sun_irradiance: RGB                   # on a surface facing the sun
+    sun_irradiance: RGB                   # on a surface facing the sun, indoors' units
     sun_radiance: RGB                     # of the sun's disc
     sky_zenith: RGB
     sky_horizon: RGB
-    ground: RGB
-    facade: RGB
+    light: RGB                            # the sun (moon) on an outdoor surface facing it
+    fill: RGB                             # the sky's light on an upward outdoor surface
+    lit_windows: RGB                      # radiance of a neighbour's lit window (at night)
+    site: tuple[float, float, float, float]   # the house's bounds: centre x, y, half width, half depth
+    ground_z: float                       # the garden's level
+    seed: float                           # 0..1, this house's neighbourhood
 
 
-def outdoors(sun: SunLight) -> Outdoors:
-    """The outdoors under ``sun``: bright by day (it clips in a photo taken indoors), moonlit at night."""
+def outdoors(sun: SunLight, house: House | None = None) -> Outdoors:
+    """The outdoors under ``sun`` around ``house``: bright by day (brighter than any wall in the room,
+    but not so bright that a window is a white hole: an indoor photo shows the garden), warm at dusk,
+    dark blue at night with a few of the neighbours' windows lit."""
     direction = np.asarray(sun.direction)
     elevation = math.degrees(math.asin(max(-1.0, min(1.0, direction[2]))))
-    sun_up = min(1.0, max(0.0, elevation / 2.0 + 0.5)) if sun.angle <= 180.0 else MOONLIGHT
+    day = sun.angle <= 180.0
+    sun_up = min(1.0, max(0.0, elevation / 2.0 + 0.5)) if day else MOONLIGHT
     irradiance = SUN_IRRADIANCE * np.asarray(sun.gain) * sun_up
-    outside = OUTDOOR_DAY if sun.angle <= 180.0 else 3 * MOONLIGHT
-    sky = np.asarray(srgb8_to_linear(sun.sky)) * outside
-    level = float(np.mean(sun.gain)) * outside
-    return Outdoors(_rgb(direction), _rgb(irradiance), _rgb(irradiance * 4.0), _rgb(sky * 1.6),
-                    _rgb(sky * 0.8 + 0.6 * np.asarray(sun.gain) * outside),
-                    _rgb(np.array(GROUND_ALBEDO) * level * 1.6),
-                    _rgb(np.array(FACADE_ALBEDO) * np.asarray(sun.gain) * 1.3 * outside))
+    # How high the sun stands (0 at the horizon, 1 at noon) and how much daylight is left at dusk.
+    height = math.sqrt(max(math.sin(math.radians(sun.angle)), 0.0)) if day else 0.0
+    below = 0.0 if day else min(sun.angle - 180.0, 360.0 - sun.angle)
+    daylight = 1.0 if day else max(0.0, 1.0 - below / TWILIGHT_DEG)
+    zenith = _lerp(_lin(SKY_NIGHT_ZENITH), _lerp(_lin(SKY_DUSK_ZENITH), _lin(SKY_NOON), height), daylight)
+    horizon = _lerp(_lin(SKY_NIGHT), _lerp(_lin(SKY_HORIZON), _lin(SKY_NOON_HORIZON), height), daylight)
+    level = OUTDOOR_DAY * daylight * (OUTDOOR_DUSK + (1.0 - OUTDOOR_DUSK) * height) + OUTDOOR_NIGHT * (1.0 - daylight)
+    gain = np.asarray(sun.gain) / max(float(np.max(sun.gain)), 1e-6)           # the daylight's colour
+    gain = gain if day else 0.5 + 0.5 * gain                  # moonlight looks grey more than blue
+    light = gain * OUTDOOR_SUN * level * (sun_up if day else MOONLIGHT)
+    # What lights the garden besides the sun: mostly the sky overhead, its colour diluted by bounces;
+    # as strong at dusk as the sky is bright (a dusky zenith's dark blue is not a dark sky).
+    sky = np.asarray(_lerp(horizon, zenith, 0.85))
+    strength = daylight * SKY_FILL + (1.0 - daylight) * float(sky.mean())
+    fill = (0.4 + 0.6 * sky / float(sky.mean())) * strength * OUTDOOR_FILL * level
+    lamps_lit = max(0.0, 1.0 - daylight * (0.8 + 0.3 * height))   # the neighbours switch on at dusk
+    glow = np.asarray(black_body(2700.0)) * LIT_WINDOW * lamps_lit
+    site, ground_z = _site(house)
+    return Outdoors(_rgb(direction), _rgb(irradiance), _rgb(irradiance * 4.0),
+                    _rgb(np.asarray(zenith) * level), _rgb(np.asarray(horizon) * level),
+                    _rgb(light), _rgb(fill), _rgb(glow), site, ground_z, _house_seed(house))
+
+
+def _lin(rgb: RGB) -> RGB:
+    red, green, blue = (int(round(c)) for c in rgb)
+    return srgb8_to_linear((red, green, blue))
+
+
+def _site(house: House | None) -> tuple[tuple[float, float, float, float], float]:
+    """Where the house stands: its rooms' bounds (centre, half extents) and the garden's level."""
+    if house is None or not house.rooms:
+        return (0.0, 0.0, 6.0, 5.0), -GROUND_BELOW_FLOOR
+    points = np.asarray([p for room in house.rooms for p in room.floor])
+    low, high = points.min(axis=0), points.max(axis=0)
+    centre, half = (low + high) / 2.0, (high - low) / 2.0
+    floor = min(room.floor_z for room in house.rooms)
+    return (float(centre[0]), float(centre[1]), float(half[0]), float(half[1])), floor - GROUND_BELOW_FLOOR
+
+
+def _house_seed(house: House | None) -> float:
+    """A number in [0, 1) fixed for a house (its number, or an imported home's name): the same house
+    always looks out on the same neighbourhood, two houses on different ones."""
+    if house is None:
+        return 0.0
+    return (zlib.crc32(f"{house.number}:{house.name}".encode()) % 10007) / 10007.0
 
 
 @dataclass(frozen=True)
@@ -211,7 +268,7 @@ def scene_lights(house: House, state: WorldState, lamps_on: bool = True) -> Scen
     on = [lt for lt in house.lights if state.lights.get(lt.id, False)] if lamps_on else []
     looks = state.settings()
     lamps = tuple(dimmed(lamps_at(on, looks.light_temperature), looks.lamp_dimmer))
-    return SceneLights(sun, outdoors(sun), WINDOW_RADIANCE * indoor_daylight(sun), lamps,
+    return SceneLights(sun, outdoors(sun, house), WINDOW_RADIANCE * indoor_daylight(sun), lamps,
                        {room.id: room_ambient(house, room, sun, lamps) for room in house.rooms})
 
 

@@ -309,7 +309,9 @@ class GLRenderer:
         uniforms = {
             "u_sun_dir": outdoors.sun_direction, "u_sun_irradiance": outdoors.sun_irradiance,
             "u_sun_radiance": outdoors.sun_radiance, "u_sky_zenith": outdoors.sky_zenith,
-            "u_sky_horizon": outdoors.sky_horizon, "u_ground": outdoors.ground, "u_facade": outdoors.facade,
+            "u_sky_horizon": outdoors.sky_horizon, "u_outdoor_light": outdoors.light,
+            "u_outdoor_fill": outdoors.fill, "u_lit_windows": outdoors.lit_windows, "u_site": outdoors.site,
+            "u_ground_z": outdoors.ground_z, "u_outdoor_seed": outdoors.seed,
         }
         for name, value in uniforms.items():
             self._set(name, value, also=(self.sky_program,))

@@ -30,6 +30,9 @@ class TinyRenderer:
         projection = projection_from_K(K, width, height, near, far, SAMPLE_OFFSET)
         self._projection = projection.T.ravel().tolist()          # column-major for pybullet
         self.lighting = Lighting(world, K, width, height)
+        u, v = np.meshgrid(np.arange(width) + 0.5, np.arange(height) + 0.5)
+        self._rays = np.stack([u, v, np.ones_like(u)], axis=-1) @ np.linalg.inv(K).T   # optical frame
+        self._rays /= np.linalg.norm(self._rays, axis=-1, keepdims=True)
 
     def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None,
                radiance: bool = False, development: Development | None = None) -> RenderedViews:
@@ -55,8 +58,19 @@ class TinyRenderer:
         rgb = self.lighting.apply(cv2.cvtColor(rgba, cv2.COLOR_RGBA2RGB), depth, instance, rotation,
                                   position, sun, list(scene.lamps))
         if background.any():
-            rgb[background] = sun.sky
+            rgb[background] = self._outdoors(background, rotation, np.asarray(sun.sky, np.float32))
         return RenderedViews(rgb, depth, instance, background)
+
+    def _outdoors(self, background: np.ndarray, rotation: np.ndarray, sky: np.ndarray) -> np.ndarray:
+        """A cheap stand-in for the GL renderer's outdoors: the sky deepening from the horizon up and
+        a darker lawn below it, hazing into the horizon (a window is not one flat colour)."""
+        up = self._rays[background] @ np.asarray(rotation, np.float32)[2]      # sine of the elevation
+        zenith = sky * np.array([0.7, 0.82, 1.0], np.float32)
+        lawn = np.array([0.42, 0.55, 0.3], np.float32) * float(sky.mean())
+        above = np.clip(up, 0.0, 1.0)[:, None] ** 0.5
+        haze = np.exp(np.minimum(up, 0.0) * 12.0)[:, None]
+        colour = np.where(up[:, None] >= 0.0, sky + (zenith - sky) * above, lawn + (sky - lawn) * 0.6 * haze)
+        return np.clip(colour, 0.0, 255.0).astype(np.uint8)
 
     def release(self) -> None:
         """Nothing to free: pybullet's client belongs to the World."""

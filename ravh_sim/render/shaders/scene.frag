@@ -295,7 +295,7 @@ void main() {
 #if PATTERN_ID == PATTERN_GLASS
     {
         // Window glass: the outdoors through it, the room faintly reflected.
-        vec3 through = outdoor(-v);
+        vec3 through = outdoor_at(v_world, -v);
         float fresnel = 0.04 + 0.96 * pow(clamp(1.0 - dot(n, v), 0.0, 1.0), 5.0);
         colour = mix(through * vec3(0.92, 0.96, 0.95), ambient * 0.5, fresnel);
     }

@@ -8,7 +8,7 @@ void main() {
     vec4 far_point = u_inverse_view_proj * vec4(v_ndc, 1.0, 1.0);
     vec4 near_point = u_inverse_view_proj * vec4(v_ndc, -1.0, 1.0);
     vec3 d = normalize(far_point.xyz / far_point.w - near_point.xyz / near_point.w);
-    vec3 c = outdoor(d);
+    vec3 c = outdoor_at(near_point.xyz / near_point.w, d);
     out_hdr = vec4(c, log(luminance(c) + 1e-4));
     out_depth = 0.0;
     out_instance = 0;
