@@ -215,7 +215,9 @@ def test_ctrl_c_ends_a_raid_with_its_summary(tmp_path):
     saved = json.loads((out / "raid.json").read_text())
     assert printed == saved and saved["status"] == "interrupted (Ctrl-C)", (saved, _log_tails(out))
     assert "Traceback" not in stderr + _log_tails(out), stderr[-3000:] + _log_tails(out)
-    assert saved["captures"] == saved["requested"] == len(_consistent(out)) >= 3
+    # every capture the behaviour was answered for is stored; one answered while Ctrl-C stopped the
+    # behaviour is stored too, though the behaviour, stopped, never logged its answer
+    assert saved["captures"] == len(_consistent(out)) >= saved["requested"] >= 3
 
 
 # Runs a command with writes past N bytes per file failing (EFBIG), as on a full disk; its children inherit it.
