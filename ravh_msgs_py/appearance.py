@@ -12,7 +12,7 @@ An appearance request is one JSON object saying what to change; the reply says w
 
     {"sun_angle": "night", "lights": {"ceiling": "on", "Lamp_0": "random"},
      "doors": {"Door_2": "closed"}, "paint": {"Bedroom_1": {"walls": "brick"}},
-     "models": {"Bed_0": 2, "all": "random"}, "seed": 7}
+     "models": {"Bed_0": 2, "all": "random"}, "dressing": "tidy", "seed": 7}
 
 Keys are all optional; ``seed`` drives this request's random choices; ``randomise: SEED`` alone
 re-draws lights, doors, paint and models as the settings' "random" does. Replies use the envelope of
@@ -26,7 +26,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from random import Random
 from types import MappingProxyType
-from typing import Annotated, Any, Self, TypeVar
+from typing import Annotated, Any, Literal, Self, TypeVar
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, GetCoreSchemaHandler, WrapSerializer
 from pydantic_core import CoreSchema, core_schema
@@ -39,6 +39,7 @@ SWITCH = ("on", "off", "random")
 DOOR = ("open", "closed", "random")
 LIGHT_GROUPS = ("all", "ceiling", "lamps")   # lamps: every light that is not a ceiling light
 SURFACES = ("walls", "floor")
+DRESSING = ("none", "tidy", "lived-in")   # what a house holds besides the paper's objects (ravh_sim.world.dressing)
 SEED_MAX = 2**32 - 1       # the one seed range: settings files, command-line flags and requests
 
 Seed = Annotated[int, Field(strict=True, ge=0, le=SEED_MAX)]
@@ -104,6 +105,9 @@ class Looks(BaseModel):
     light_temperature: Annotated[float, Knob("kelvin", 1000.0, 10000.0)] = 2700.0
     # every lamp's dimmer, a share of its power; at the default, the power the house files give it
     lamp_dimmer: Annotated[float, Knob("share of full power", 0.1, 1.0)] = 1.0
+    # the things people put in a home (plates, books, pillows, rugs, curtains...), placed from the seed;
+    # at the default, none: a record from before dressing is the bare house it was
+    dressing: Literal["none", "tidy", "lived-in"] = "none"
 
     def changed(self, **fields: Any) -> Self:
         """A copy with ``fields`` replaced, validated like the original (a ValueError if one is bad)."""
@@ -112,7 +116,7 @@ class Looks(BaseModel):
 
 KNOBS: dict[str, Knob] = {name: knob for name, info in Looks.model_fields.items()
                           for knob in info.metadata if isinstance(knob, Knob)}
-KEYS = (*KNOBS, "lights", "doors", "paint", "models", "seed", "randomise")
+KEYS = (*KNOBS, "lights", "doors", "paint", "models", "dressing", "seed", "randomise")
 
 
 def request(**changes: Any) -> str:
@@ -151,6 +155,8 @@ def parse(text: str | bytes | dict) -> dict[str, Any]:
         if not ok:
             raise QueryError(BAD_REQUEST, f"models.{obj}: expected default, random, an index >= 0 or "
                                           f"{{inherit: OBJECT_ID}}, got {value!r}")
+    if "dressing" in data and data["dressing"] not in DRESSING:
+        raise QueryError(BAD_REQUEST, f"dressing: expected one of {', '.join(DRESSING)}, got {data['dressing']!r}")
     for key in ("seed", "randomise"):
         if key in data and not (_is_int(data[key]) and 0 <= data[key] <= SEED_MAX):
             raise QueryError(BAD_REQUEST, f"{key}: expected an integer in 0..{SEED_MAX}")

@@ -16,7 +16,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ravh_msgs_py.appearance import DOOR, SWITCH
+from ravh_msgs_py.appearance import DOOR, DRESSING, SWITCH
 from ravh_msgs_py.names import DEFAULT_PROFILE
 from ravh_sim.bench import BENCHES
 from ravh_sim.errors import UserError
@@ -62,6 +62,8 @@ def _world_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("house", help=HOUSE_HELP)
     p.add_argument("--seed", type=int, default=None, help="seed for every random choice (default: config)")
     p.add_argument("--config", type=Path, default=None, help="settings YAML (see config/default.yaml)")
+    p.add_argument("--dressing", choices=DRESSING, default=None,
+                   help="what else the house holds: none, tidy or lived-in (default: config)")
 
 
 def _resolved(args: argparse.Namespace):
@@ -69,6 +71,8 @@ def _resolved(args: argparse.Namespace):
     from ravh_sim.world.settings import load_settings, resolve
     house = load_house(args.house)
     settings = load_settings(args.config)
+    if getattr(args, "dressing", None) is not None:
+        settings["dressing"] = args.dressing
     return house, resolve(settings, house, args.seed, str(args.config or "config/default.yaml"))
 
 
@@ -143,7 +147,9 @@ def cmd_plan(args: argparse.Namespace) -> int:
     if args.free_space or args.path:
         from ravh_sim.nav.freespace import free_space
         from ravh_sim.nav.planner import plan_path
-        free = free_space(house, resolved.doors, resolved.models)
+        from ravh_sim.world.dressing import dressing
+        free = free_space(house, resolved.doors, resolved.models,
+                          dressed=dressing(house, resolved.models, resolved.dressing, resolved.seed))
         if args.path:
             x0, y0, x1, y1 = args.path
             closed = [d for d, is_open in resolved.doors.items() if not is_open]

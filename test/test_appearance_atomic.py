@@ -13,7 +13,7 @@ from ravh_sim.errors import UserError
 from ravh_sim.runtime import SimRuntime
 from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import make_footprint
-from ravh_sim.world.scene import World
+from ravh_sim.world.scene import Visual, World
 from ravh_sim.world.settings import load_settings, resolve
 from ravh_sim.world.solids import model_count
 
@@ -34,7 +34,10 @@ def full_state(world: World) -> dict:
     c = world.client
     bodies = {}
     for inst in world.instances:
-        visual = world.visuals[inst.body]
+        if inst.body < 0:                 # a dressing object never shown (ravh_sim.world.dressing)
+            bodies[inst.name] = None
+            continue
+        visual = world.visuals.get(inst.body, Visual(paint="parked dressing"))
         bodies[inst.name] = (
             pb.getBasePositionAndOrientation(inst.body, physicsClientId=c),
             pb.getCollisionShapeData(inst.body, -1, physicsClientId=c),

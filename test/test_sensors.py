@@ -107,7 +107,10 @@ def box_house():
 
 
 def _world(house, renderer="auto", seed=0):
-    return World(house, resolve(load_settings(), house, seed), renderer=resolve_backend(renderer))
+    """The house with the default settings, undressed: these tests measure sensors against its known
+    walls and objects (dressing has tests of its own, test_dressing.py)."""
+    settings = resolve(load_settings(), house, seed).changed(dressing="none")
+    return World(house, settings, renderer=resolve_backend(renderer))
 
 
 @pytest.fixture(scope="module")
@@ -443,7 +446,9 @@ def test_day_is_brighter_than_sunset_is_brighter_than_night(camera, appearance):
     for preset in ("day", "sunset", "night"):
         appearance.set_knob("sun_angle", preset)
         means[preset] = _mean(camera.capture(3.0, 2.0, math.pi).rgb)
-    assert means["day"] > 1.2 * means["sunset"] > 1.2 * 1.5 * means["night"]
+    # (the window shows the garden at sunset instead of clipping white, so the frame's lead over the
+    # lamp-lit night is 1.45x, not the 1.5x a white window gave)
+    assert means["day"] > 1.2 * means["sunset"] > 1.2 * 1.3 * means["night"]
     assert sun_light(180).gain[0] > sun_light(180).gain[2]          # sunset light is warm
     assert sun_light(200).gain[2] > sun_light(200).gain[0]          # night is blue
 

@@ -5,7 +5,10 @@ Writes, for every dataset folder under DIR (one raid, or a ``ravh dataset build`
 - ``OUT/instances.json``: COCO instance annotations, one per object seen in a capture (boxes, areas and
   RLE masks from pycocotools, so they agree with its evaluator to the pixel), our object types as
   categories, and per annotation ``attributes``: the object's room and room type, object id and
-  instance id. Images point at the datasets' RGB files (``file_name`` relative to DIR).
+  instance id. Dressing objects (:mod:`ravh_sim.world.dressing`, ``kind: dressing``) are not annotated:
+  the export keeps the paper's object list, as the evaluations do; the semantic images give them their
+  own class ids (their types appended after the paper's, :data:`DRESSING_CLASSES`). Images point at
+  the datasets' RGB files (``file_name`` relative to DIR).
 - ``semantic/NNNNNN.png`` beside each dataset's ``mask/NNNNNN.png``: 8-bit semantic class ids per
   pixel (:data:`SEMANTIC_CLASSES`).
 
@@ -35,16 +38,26 @@ OBJECT_CLASSES = (
     "Refrigerator", "Shelf", "ShowerCabin", "Sink", "Sofa", "Standard", "Station", "Stool", "Table",
     "Toilet", "Toothbrush", "Towel", "Tv", "Washbasin", "WashingMachine",
 )
+DRESSING_CLASSES = (
+    "Plate", "Bowl", "FruitBowl", "Vase", "Pan", "Kettle", "Bottle", "DishRack", "Book", "Box", "Plant",
+    "Pillow", "Duvet", "Cushion", "Throw", "Rug", "Curtain", "Blind",
+)
+"""The types of dressing objects (:mod:`ravh_sim.world.dressing`) that the paper's list lacks; dressing
+cups, towels and pictures are the paper's Cup, Towel and Picture."""
 SEMANTIC_CLASSES: dict[str, int] = {name: i for i, name in enumerate(
-    ("nothing", *STRUCTURE_CLASSES, *OBJECT_CLASSES))}
-"""Class name -> id in the semantic images: 0 nothing, 1-5 structure, 6-47 object types."""
+    ("nothing", *STRUCTURE_CLASSES, *OBJECT_CLASSES, *DRESSING_CLASSES))}
+"""Class name -> id in the semantic images: 0 nothing, 1-5 structure, 6-47 object types, 48-65 the
+dressing's own types."""
+OBJECT_KINDS = ("object", "dressing")
+"""Instance kinds whose semantic class is their type (the COCO annotations: ``kind: object`` alone)."""
 SEMANTIC_DIR = "semantic"
 INSTANCES_JSON = "instances.json"
 
 
 def class_of(instance: dict[str, Any]) -> str:
-    """The semantic class of a footprint instance: its object type, or its structure kind."""
-    return instance["type"] if instance["kind"] == "object" else instance["kind"]
+    """The semantic class of a footprint instance: its object (or dressing object's) type, or its
+    structure kind."""
+    return instance["type"] if instance["kind"] in OBJECT_KINDS else instance["kind"]
 
 
 def class_lookup(ds: Dataset) -> np.ndarray:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from ravh_msgs_py.appearance import KNOBS
 from ravh_sim.world.state import WorldState
 
-GEOMETRY_FIELDS = frozenset({"doors", "models", "paint"})
+GEOMETRY_FIELDS = frozenset({"doors", "models", "paint", "dressing"})
 SUN_FIELDS = frozenset({"sun_angle"})
 EVERY_LAMP_FIELDS = frozenset(KNOBS) - SUN_FIELDS
 

@@ -38,6 +38,7 @@ import numpy as np
 
 from ravh_sim.errors import UnknownNameError
 from ravh_sim.nav.grid import FREE, OCCUPIED, UNKNOWN, Grid, distance_cells
+from ravh_sim.world.dressing import Dressed
 from ravh_sim.world.geometry import box_corners
 from ravh_sim.world.house import Door, House, Wall
 from ravh_sim.world.solids import Footprint, object_parts
@@ -57,26 +58,28 @@ SCALE = 1 << SHIFT
 
 def free_space(house: House, door_open: Mapping[str, bool], models: Mapping[str, int] | None = None,
                radius: float = 0.25, height: float = 1.6, resolution: float = 0.05,
-               margin: float = 0.5) -> Grid:
+               margin: float = 0.5, dressed: Sequence[Dressed] = ()) -> Grid:
     """Cells where a robot disc of ``radius`` and ``height`` fits: FREE, OCCUPIED or UNKNOWN.
 
     ``door_open`` maps door ids to open (True) or closed; doors it omits keep their default state.
     ``models`` maps object ids to the model variant shown in the world: pass the resolved settings'
     ``models`` (inheritance already followed) to match the world; objects it omits use their
-    default model.
+    default model. ``dressed``: the dressing shown (:func:`ravh_sim.world.dressing.dressing`); those
+    that collide block like furniture.
     """
-    return inflate(obstacles(house, door_open, models, height, resolution, margin), radius)
+    return inflate(obstacles(house, door_open, models, height, resolution, margin, dressed), radius)
 
 
 def obstacles(house: House, door_open: Mapping[str, bool], models: Mapping[str, int] | None = None,
-              height: float = 1.6, resolution: float = 0.05, margin: float = 0.5) -> Grid:
+              height: float = 1.6, resolution: float = 0.05, margin: float = 0.5,
+              dressed: Sequence[Dressed] = ()) -> Grid:
     """The uninflated map: known floor FREE, obstacles at robot height OCCUPIED, outside UNKNOWN.
 
     The grid covers ``house.bounds`` plus ``margin`` on every side, aligned to ``resolution``.
     """
     open_state, models, grid = map_start(house, door_open, models, resolution, margin, height=height)
     blocked = np.zeros(grid.shape, np.uint8)
-    for box in _obstacle_boxes(house, open_state, models, height, resolution):
+    for box in _obstacle_boxes(house, open_state, models, height, resolution, dressed):
         fill_box(blocked, box, grid)
     grid.data[blocked > 0] = OCCUPIED
     return grid
@@ -130,7 +133,7 @@ Box = Footprint
 
 
 def _obstacle_boxes(house: House, open_state: Mapping[str, bool], models: Mapping[str, int],
-                    height: float, resolution: float = 0.0) -> Iterator[Box]:
+                    height: float, resolution: float = 0.0, dressed: Sequence[Dressed] = ()) -> Iterator[Box]:
     """Footprints of everything that blocks a robot of ``height``; object parts thinner than
     ``resolution`` grow to it inside their object (see ``Placed.footprints``)."""
     floor_z = {room.id: room.floor_z for room in house.rooms}
@@ -146,6 +149,10 @@ def _obstacle_boxes(house: House, open_state: Mapping[str, bool], models: Mappin
             base = floor_z[obj.room]
             placed = object_parts(house, obj, models.get(obj.id))
             yield from placed.footprints(base + MIN_OBSTACLE_TOP, base + height, resolution)
+    for item in dressed:
+        if item.slot.collides:
+            base = floor_z[item.slot.room]
+            yield from item.placed().footprints(base + MIN_OBSTACLE_TOP, base + height, resolution)
 
 
 def wall_box(wall: Wall) -> Box:

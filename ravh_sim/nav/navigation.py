@@ -24,6 +24,7 @@ from ravh_sim.nav.mapio import write_map
 from ravh_sim.nav.obstaclemap import obstacle_map
 from ravh_sim.nav.planner import Path, Point, Unreachable, densify, plan_path
 from ravh_sim.sensors.laser import LaserSpec
+from ravh_sim.world.dressing import Dressed, dressing
 from ravh_sim.world.house import House
 from ravh_sim.world.state import WorldState
 
@@ -58,27 +59,33 @@ class Navigation:
     def map(self) -> Grid:
         """The inflated free-space grid for the current doors and models (the same object until they
         change): FREE where the robot's centre may go."""
-        return self._current("free_space", lambda doors, models: free_space(
+        return self._current("free_space", lambda doors, models, dressed: free_space(
             self.house, doors, models, radius=self.profile.radius, height=self.profile.height,
-            resolution=self.resolution))
+            resolution=self.resolution, dressed=dressed))
 
     def walkable(self, radius: float) -> Grid:
         """Free space for a disc of ``radius`` at the robot's height (the paper's grid rule bakes its
         walkable area for a 0.1 m agent, narrower than our robot)."""
-        return self._current(f"walkable {radius}", lambda doors, models: free_space(
-            self.house, doors, models, radius=radius, height=self.profile.height, resolution=self.resolution))
+        return self._current(f"walkable {radius}", lambda doors, models, dressed: free_space(
+            self.house, doors, models, radius=radius, height=self.profile.height, resolution=self.resolution,
+            dressed=dressed))
 
     def obstacle_map(self) -> Grid:
         """The uninflated obstacle map at laser height for the current doors and models."""
-        return self._current("obstacles", lambda doors, models: obstacle_map(
-            self.house, doors, models, self.profile.laser.height, self.resolution))
+        return self._current("obstacles", lambda doors, models, dressed: obstacle_map(
+            self.house, doors, models, self.profile.laser.height, self.resolution, dressed=dressed))
 
-    def _current(self, kind: str, build: Callable[[Mapping[str, bool], Mapping[str, int]], Grid]) -> Grid:
+    def dressed(self) -> tuple[Dressed, ...]:
+        """The dressing the world shows now (its level, models and seed)."""
+        return dressing(self.house, self.state.models, self.state.dressing, self.state.seed)
+
+    def _current(self, kind: str, build: Callable[[Mapping[str, bool], Mapping[str, int], tuple[Dressed, ...]],
+                                                  Grid]) -> Grid:
         """The cached grid of ``kind``, rebuilt when the layout revision moved since it was built."""
         if self.state.layout_revision != self._built_at:
             self._grids, self._built_at = {}, self.state.layout_revision
         if kind not in self._grids:
-            self._grids[kind] = build(self.state.doors, self.state.models)
+            self._grids[kind] = build(self.state.doors, self.state.models, self.dressed())
         return self._grids[kind]
 
     def closed_doors(self) -> list[str]:
@@ -99,7 +106,8 @@ class Navigation:
         """Name the closed doors that really cut the way: those on the path that would exist with every
         door open; if none would exist, walls or furniture are to blame, not the doors."""
         open_all = free_space(self.house, dict.fromkeys(self.state.doors, True), self.state.models,
-                              radius=self.profile.radius, height=self.profile.height, resolution=self.resolution)
+                              radius=self.profile.radius, height=self.profile.height, resolution=self.resolution,
+                              dressed=self.dressed())
         try:
             path = plan_path(open_all, start, goal)
         except Unreachable:

@@ -14,7 +14,8 @@ Cells enclosed by one object's cut (inside a cabinet's outline, a leg, a closed 
 OCCUPIED too, as map_server maps draw walls solid: the laser never reaches them and no robot stands
 there (a SLAM map would leave them UNKNOWN; an outline open on one side, like a shelf's front, is not
 closed and stays as cut). Objects entirely below the laser plane (a low stool, a rug) and parts above
-it (a table top) are not in this map, because the laser does not see them.
+it (a table top) are not in this map, because the laser does not see them. Dressing objects that
+collide (:mod:`ravh_sim.world.dressing`: floor plants, curtains...) are cut like furniture.
 
 The robot's own planner and behaviours use the inflated free space instead (``Navigation.map``,
 topic ``/ravh/free_space``, :mod:`ravh_sim.nav.freespace`): the boxes of everything the robot's body
@@ -23,13 +24,14 @@ would bump into, from the floor to its height, so it still keeps off low furnitu
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 import cv2
 import numpy as np
 
 from ravh_sim.nav.freespace import SCALE, SHIFT, fill_box, map_start, pixels, wall_box
 from ravh_sim.nav.grid import OCCUPIED, Grid
+from ravh_sim.world.dressing import Dressed
 from ravh_sim.world.house import House
 from ravh_sim.world.solids import object_parts
 from ravh_sim.world.structure import solid_walls
@@ -39,9 +41,11 @@ UNSEEN_TYPES = frozenset({"Station"})
 
 
 def obstacle_map(house: House, door_open: Mapping[str, bool], models: Mapping[str, int] | None,
-                 laser_height: float, resolution: float, margin: float = 0.5) -> Grid:
+                 laser_height: float, resolution: float, margin: float = 0.5,
+                 dressed: Sequence[Dressed] = ()) -> Grid:
     """Known floor FREE, what the laser at ``laser_height`` above the floor hits OCCUPIED, outside
-    UNKNOWN; doors and models as :func:`ravh_sim.nav.freespace.obstacles` takes them, on the same grid."""
+    UNKNOWN; doors, models and dressing as :func:`ravh_sim.nav.freespace.obstacles` takes them, on the
+    same grid."""
     open_state, models, grid = map_start(house, door_open, models, resolution, margin, laser_height=laser_height)
     hit = np.zeros(grid.shape, np.uint8)
     floor_z = {room.id: room.floor_z for room in house.rooms}
@@ -53,6 +57,9 @@ def obstacle_map(house: House, door_open: Mapping[str, bool], models: Mapping[st
             continue
         placed = object_parts(house, obj, models.get(obj.id))
         _draw_section(hit, placed.section(floor_z[obj.room] + laser_height), grid)
+    for item in dressed:
+        if item.slot.collides:
+            _draw_section(hit, item.placed().section(floor_z[item.slot.room] + laser_height), grid)
     grid.data[hit > 0] = OCCUPIED
     return grid
 

@@ -68,7 +68,8 @@ def preset_settings(preset: RaidPreset, seed: int) -> dict:
     return {"seed": seed,
             "lights": {"sun_angle": preset.sun, "ceiling": preset.ceiling, "lamps": preset.lamps},
             "paint": {"walls": preset.paint, "floors": preset.paint},
-            "models": {"all": preset.models}}
+            "models": {"all": preset.models},
+            "dressing": "none"}          # the paper's raids: the paper's objects, nothing else
 
 
 def run_raid(house: int | str, raid: int, out: Path, fast: bool = False, seed: int | None = None,

@@ -12,7 +12,7 @@ from ravh_sim.look.materials import PATTERN
 if TYPE_CHECKING:
     import moderngl
 
-KINDS = {"floor": 0, "ceiling": 1, "walls": 2, "object": 3, "door": 4, "window": 5}
+KINDS = {"floor": 0, "ceiling": 1, "walls": 2, "object": 3, "door": 4, "window": 5, "dressing": 6}
 MAX_LIGHTS = 32                       # switched-on lights with a shadow map
 MAX_ROOMS = 32                        # rooms of a house (the 30 houses have at most 14)
 MAX_WINDOWS = 32                      # windows of a house (the 30 houses have at most 14)

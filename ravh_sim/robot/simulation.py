@@ -24,6 +24,7 @@ from ravh_sim.nav.freespace import free_space
 from ravh_sim.nav.grid import FREE
 from ravh_sim.robot.profile import RobotProfile, load_profile
 from ravh_sim.robot.robot import Robot
+from ravh_sim.world.dressing import dressing
 from ravh_sim.world.scene import World
 from ravh_sim.world.settings import AgentSpec
 
@@ -82,7 +83,9 @@ class Simulation:
 
 def _nearest_free_pose(world: World, profile: RobotProfile, pose: tuple[float, float, float]) -> list[float]:
     """[x, y, yaw]: the free-space map's free cell nearest ``pose`` (yaw kept), where the robot fits."""
-    grid = free_space(world.house, world.state.doors, world.state.models, profile.radius, profile.height)
+    state = world.state
+    grid = free_space(world.house, state.doors, state.models, profile.radius, profile.height,
+                      dressed=dressing(world.house, state.models, state.dressing, state.seed))
     xs, ys = grid.cell_centres()
     d2 = np.where(grid.data == FREE, (xs - pose[0]) ** 2 + (ys - pose[1]) ** 2, np.inf)
     row, col = np.unravel_index(int(np.argmin(d2)), d2.shape)

@@ -39,7 +39,7 @@ from ravh_sim.sensors.laser import Laser
 from ravh_sim.sensors.mount import floor_at
 from ravh_sim.sensors.readings import Scan
 
-CLASSES = {"walls": "walls", "object": "objects", "window": "objects", "door": "doors"}
+CLASSES = {"walls": "walls", "object": "objects", "window": "objects", "door": "doors", "dressing": "dressing"}
 """Instance kind -> surface class reported."""
 PLANE_BAND = 0.003
 """m: a depth pixel whose point lies this close to the laser's plane is on it (a pixel of the camera

@@ -22,7 +22,7 @@ from collections.abc import Callable, Mapping
 from functools import lru_cache
 from typing import Any
 
-from ravh_msgs_py.appearance import KNOBS, LIGHT_GROUPS, SURFACES, SWITCH
+from ravh_msgs_py.appearance import DRESSING, KNOBS, LIGHT_GROUPS, SURFACES, SWITCH
 from ravh_msgs_py.query import UNKNOWN_ID, QueryError
 from ravh_sim.errors import UnknownNameError, UserError
 from ravh_sim.world import paints
@@ -52,6 +52,7 @@ class Appearance:
         self.world = world
         self.house = world.house
         self.state = world.state
+        self._bringing = False
 
     # ------------------------------------------------------------------ global knobs and lights
     def set_knob(self, name: str, choice: float | str, seed: int | None = None) -> None:
@@ -106,7 +107,18 @@ class Appearance:
         if index != self.state.models[object_id]:
             self.world.load_model(object_id, index)
             self.state.write(models={object_id: index})
+            if not self._bringing:            # what stands on it moves with its new model
+                self.set_dressing(self.state.dressing, force=True)
         return index
+
+    def set_dressing(self, level: str, force: bool = False) -> None:
+        """Show the dressing of ``level`` (none, tidy, lived-in), laid out for the objects' models now;
+        ``force``: lay it out again even at the same level (an object model changed)."""
+        if level not in DRESSING:
+            raise UnknownNameError("dressing level", level, list(DRESSING))
+        if level != self.state.dressing or force:
+            self.world.dress(level, self.state.models)
+            self.state.write(dressing=level)
 
     def set_door(self, door_id: str, is_open: bool) -> None:
         if door_id not in self.house.door_by_id:
@@ -186,6 +198,8 @@ class Appearance:
         """The settings a parsed appearance request asks for: the current ones with the items it names
         resolved; changes nothing. Unknown names and impossible values are refused here."""
         self.check_names(request)
+        if "dressing" in request and request["dressing"] not in DRESSING:
+            raise UserError(f"dressing: expected one of {', '.join(DRESSING)}, got {request['dressing']!r}")
         lights, doors, rooms, models = {}, {}, {}, {}
         inherit = {}
         for which, state in request.get("lights", {}).items():
@@ -216,7 +230,8 @@ class Appearance:
             lights={**now.lights, **{lid: picked.lights[lid] for lid in lights}},
             doors={**now.doors, **{d: picked.doors[d] for d in doors}},
             paint={r: {**s, **{k: picked.paint[r][k] for k in rooms.get(r, {})}} for r, s in now.paint.items()},
-            models={**now.models, **chosen_models})
+            models={**now.models, **chosen_models},
+            dressing=request.get("dressing", now.dressing))
         self.check(target)
         return target
 
@@ -234,6 +249,7 @@ class Appearance:
                 stuck.append((item, e))
 
         state = self.state
+        models_before = dict(state.models)
         change("the global knobs", lambda: state.write(**{name: getattr(target, name) for name in KNOBS}))
         lights, doors, paint, models = target.lights, target.doors, target.paint, target.models
         for lid in list(state.lights):
@@ -246,9 +262,15 @@ class Appearance:
             for surface, paint_now in list(surfaces.items()):
                 if surface in paint.get(room_id, {}) and paint[room_id][surface] != paint_now:
                     change(f"paint {room_id}.{surface}", self.set_paint, room_id, surface, paint[room_id][surface])
-        for oid, model in list(state.models.items()):
-            if oid in models and models[oid] != model:
-                change(f"model of {oid} (index {models[oid]})", self.set_object_model, oid, models[oid])
+        self._bringing = True
+        try:
+            for oid, model in list(state.models.items()):
+                if oid in models and models[oid] != model:
+                    change(f"model of {oid} (index {models[oid]})", self.set_object_model, oid, models[oid])
+        finally:
+            self._bringing = False
+        if target.dressing != state.dressing or dict(state.models) != models_before:
+            change(f"dressing {target.dressing}", self.set_dressing, target.dressing, True)
 
     def _lights_named(self, which: str) -> list[str]:
         """The lights of a group (LIGHT_GROUPS) or the one light named ``which``."""

@@ -2,8 +2,10 @@
 
 The instance table is a pure function of the house and the resolved settings (no pybullet): one entry
 per room surface (floor, ceiling, walls) and per labelled object, in a fixed order, numbered from 1
-(0 means "nothing" in instance images). The footprint is that table with each instance's pose and
-model, plus the resolved settings; :func:`load_footprint` gives back the house number and settings,
+(0 means "nothing" in instance images), then the dressing objects the seed may place
+(:func:`dressing_instances`, ``kind: dressing``). The footprint is that table with each instance's pose and
+model (dressing rows only for those the settings' ``dressing`` level places, marked ``dressing: true``
+with their ``support``), plus the resolved settings; :func:`load_footprint` gives back the house number and settings,
 from which the World rebuilds exactly the same scene.
 """
 from __future__ import annotations
@@ -32,7 +34,7 @@ class Instance:
     """Something the camera can see, with the id that instance images store."""
     id: int                        # >= 1
     name: str                      # object id, or '<room id>/floor|ceiling|walls'
-    kind: str                      # object | door | window | floor | ceiling | walls
+    kind: str                      # object | door | window | floor | ceiling | walls | dressing
     room: str
     room_type: str
     type: str                      # object category (first tag) or the structure kind
@@ -66,6 +68,22 @@ def build_instances(house: House) -> list[Instance]:
             for i, (name, kind, room, type_, tags) in enumerate(specs, start=1)]
 
 
+def dressing_instances(house: House, seed: int) -> list[Instance]:
+    """Every dressing object that ``seed`` may place in ``house`` (:func:`ravh_sim.world.dressing.slots`),
+    numbered after the house's instances: the same ids at every level and with every object model."""
+    from ravh_sim.world.dressing import slots
+    return [Instance(s.instance, s.id, "dressing", s.room, house.room(s.room).type, s.type, s.tags,
+                     mask_color(s.instance)) for s in slots(house, seed)]
+
+
+def dressing_pose(dressed: Any) -> dict[str, Any]:
+    """A placed dressing object's footprint fields (:class:`ravh_sim.world.dressing.Dressed`)."""
+    slot = dressed.slot
+    return {"position": _r(dressed.position), "orientation": _r(quaternion_from_yaw(dressed.yaw)),
+            "yaw": _r(dressed.yaw), "model": None, "size": _r(slot.size), "asset": slot.model_id,
+            "dressing": True, "support": slot.support, "collides": slot.collides}
+
+
 def instance_pose(house: House, models: Mapping[str, int], inst: Instance) -> dict[str, Any]:
     """Position, orientation and model of an instance when objects have ``models``; ``asset`` names
     the furniture-library model drawn (see furniture/ATTRIBUTION.md), None for procedural ones."""
@@ -97,6 +115,13 @@ def make_footprint(house: House, settings: Resolved) -> dict[str, Any]:
         if inst.name in settings.lights:
             row["on"] = settings.lights[inst.name]
         rows.append(row)
+    from ravh_sim.world.dressing import dressing
+    for dressed in dressing(house, settings.models, settings.dressing, settings.seed):
+        slot = dressed.slot
+        rows.append({"id": slot.instance, "name": slot.id, "kind": "dressing",
+                     "mask_color": list(mask_color(slot.instance)), "room": slot.room,
+                     "room_type": house.room(slot.room).type, "type": slot.type, "tags": list(slot.tags),
+                     **dressing_pose(dressed)})
     imported = ({"house_name": house.name, "attribution": house.attribution, "source": house.source}
                 if house.name else {})
     return {"format": FOOTPRINT_FORMAT, "house": house.number, **imported,

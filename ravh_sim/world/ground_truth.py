@@ -5,6 +5,12 @@ Answers come from the house model, a world's state (door states, chosen models: 
 and the instance table, so the same engine serves ``ravh query``, the Python API and the ROS service.
 :meth:`GroundTruth.answer` never raises: every failure, including a bug, becomes a structured error
 reply.
+
+Dressing objects (:mod:`ravh_sim.world.dressing`, those the state's ``dressing`` level places) answer
+like objects, marked ``"dressing": true`` with their ``support``: ``object``, ``objects_in_room``,
+``objects_with_tag`` (their tags are their type and ``dressing``) and ``room`` list them; ``counts``
+keeps ``objects`` and ``objects_by_type`` to the house's own objects (the paper's list) and counts
+dressing apart (``dressing``, ``dressing_by_type``); ``tags`` counts both.
 """
 from __future__ import annotations
 
@@ -13,7 +19,8 @@ from collections.abc import Callable
 from typing import Any
 
 from ravh_msgs_py import query as q
-from ravh_sim.world.footprint import build_instances, instance_pose
+from ravh_sim.world.dressing import Dressed, dressing
+from ravh_sim.world.footprint import build_instances, dressing_instances, dressing_pose, instance_pose
 from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import House, HouseObject, Room
 from ravh_sim.world.state import WorldState
@@ -25,6 +32,7 @@ class GroundTruth:
         self.house = house
         self.state = state
         self.instances = {inst.name: inst for inst in build_instances(house)}
+        self.instances.update({inst.name: inst for inst in dressing_instances(house, state.seed)})
         self._handlers: dict[str, Callable[..., Any]] = {
             "help": lambda: q.describe(),
             "rooms": self._rooms, "room": self._room, "objects_in_room": self._objects_in_room,
@@ -51,11 +59,19 @@ class GroundTruth:
 
     def _object_or_error(self, object_id: str) -> HouseObject:
         if object_id not in self.house.object_by_id:
-            raise q.QueryError(q.UNKNOWN_ID, f"unknown object {object_id!r}", list(self.house.object_by_id))
+            known = [*self.house.object_by_id, *(d.id for d in self._dressed())]
+            raise q.QueryError(q.UNKNOWN_ID, f"unknown object {object_id!r}", known)
         return self.house.object_by_id[object_id]
 
+    def _dressed(self) -> list[Dressed]:
+        """The dressing objects the state shows now."""
+        return list(dressing(self.house, self.state.models, self.state.dressing, self.state.seed))
+
+    def _all_tags(self) -> list[str]:
+        return [t for o in self.house.objects for t in o.tags] + [t for d in self._dressed() for t in d.slot.tags]
+
     def _check_tag(self, tag: str) -> None:
-        tags = sorted({t for o in self.house.objects for t in o.tags})
+        tags = sorted(set(self._all_tags()))
         if tag not in tags:
             raise q.QueryError(q.UNKNOWN_ID, f"unknown tag {tag!r}", tags)
 
@@ -72,6 +88,13 @@ class GroundTruth:
                 "room_type": inst.room_type, "instance_id": inst.id, "mask_color": list(inst.mask_color),
                 **pose}
 
+    def _dressing_summary(self, dressed: Dressed) -> dict[str, Any]:
+        slot = dressed.slot
+        inst = self.instances[slot.id]
+        return {"id": slot.id, "type": slot.type, "tags": list(slot.tags), "room": slot.room,
+                "room_type": inst.room_type, "instance_id": inst.id, "mask_color": list(inst.mask_color),
+                **dressing_pose(dressed)}
+
     # ------------------------------------------------------------------ queries
     def _rooms(self, type: str | None = None) -> list[dict[str, Any]]:
         types = sorted({r.type for r in self.house.rooms})
@@ -83,20 +106,27 @@ class GroundTruth:
         room = self._room_or_error(id)
         return {**self._room_summary(room), "floor": [list(p) for p in room.floor],
                 "doors": [d.id for d in self.house.doors if room.id in d.rooms],
-                "objects": [o.id for o in self.house.objects if o.room == room.id]}
+                "objects": [o.id for o in self.house.objects if o.room == room.id]
+                + [d.id for d in self._dressed() if d.slot.room == room.id]}
 
     def _objects_in_room(self, room: str, tag: str | None = None) -> list[dict[str, Any]]:
         self._room_or_error(room)
         if tag is not None:
             self._check_tag(tag)
         return [self._object_summary(o) for o in self.house.objects
-                if o.room == room and (tag is None or tag in o.tags)]
+                if o.room == room and (tag is None or tag in o.tags)] + [
+            self._dressing_summary(d) for d in self._dressed()
+            if d.slot.room == room and (tag is None or tag in d.slot.tags)]
 
     def _objects_with_tag(self, tag: str) -> list[dict[str, Any]]:
         self._check_tag(tag)
-        return [self._object_summary(o) for o in self.house.objects if tag in o.tags]
+        return [self._object_summary(o) for o in self.house.objects if tag in o.tags] + [
+            self._dressing_summary(d) for d in self._dressed() if tag in d.slot.tags]
 
     def _object(self, id: str) -> dict[str, Any]:
+        for d in self._dressed() if id not in self.house.object_by_id else ():
+            if d.id == id:
+                return self._dressing_summary(d)
         return self._object_summary(self._object_or_error(id))
 
     def _room_at(self, x: float, y: float) -> dict[str, Any] | None:
@@ -133,12 +163,15 @@ class GroundTruth:
             self._room_or_error(room)
         objects = [o for o in self.house.objects if room is None or o.room == room]
         rooms = [r for r in self.house.rooms if room is None or r.id == room]
+        dressed = [d for d in self._dressed() if room is None or d.slot.room == room]
         return {"objects": len(objects), "rooms": len(rooms),
                 "objects_by_type": dict(sorted(Counter(o.type for o in objects).items())),
-                "rooms_by_type": dict(sorted(Counter(r.type for r in rooms).items()))}
+                "rooms_by_type": dict(sorted(Counter(r.type for r in rooms).items())),
+                "dressing": len(dressed),
+                "dressing_by_type": dict(sorted(Counter(d.slot.type for d in dressed).items()))}
 
     def _tags(self) -> dict[str, int]:
-        return dict(sorted(Counter(t for o in self.house.objects for t in o.tags).items()))
+        return dict(sorted(Counter(self._all_tags()).items()))
 
 
 def _components(neighbours: dict[str, set[str]]) -> list[list[str]]:

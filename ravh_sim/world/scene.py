@@ -23,7 +23,7 @@ import hashlib
 import math
 import os
 import sys
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,7 +34,7 @@ import trimesh
 
 from ravh_sim.poses import quaternion_from_yaw
 from ravh_sim.world import paints
-from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances
+from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances, dressing_instances
 from ravh_sim.world.house import House, HouseObject, Wall
 from ravh_sim.world.library import palette_stand_in, record
 from ravh_sim.world.mesh import colours, hulls_obj_text, write_palette_obj
@@ -129,7 +129,8 @@ class World:
         top = max(pb.getBodyUniqueId(i, physicsClientId=c) for i in range(pb.getNumBodies(physicsClientId=c)))
         lut = np.zeros(top + 1, dtype=np.int32)          # every body (robots too) has an entry
         for inst in self.instances:
-            lut[inst.body] = inst.id
+            if inst.body >= 0:                           # a dressing object never shown has no body
+                lut[inst.body] = inst.id
         return lut
 
     def ray_mask(self, hidden: Iterable[int] = ()) -> int:
@@ -182,6 +183,7 @@ class World:
                 inst.body = self._object_body(self.house.object(inst.name), self.state.models[inst.name])
                 if inst.kind == "door":
                     self.place_door(inst.name, self.state.doors[inst.name])
+        self._add_dressing()
         self._building = False
         self._flush_looks()
 
@@ -365,6 +367,61 @@ class World:
     def repaint(self, room_id: str, surface: str, paint: str) -> None:
         """Paint a room's ``walls`` or ``floor`` body."""
         self._apply_paint(self._by_name[f"{room_id}/{surface}"].body, paint)
+
+    # ------------------------------------------------------------------ dressing (ravh_sim.world.dressing)
+    def _add_dressing(self) -> None:
+        """The dressing objects the seed may place, as instances (body -1 until first shown), and those
+        of the state's level shown."""
+        self._dressing_visuals: dict[int, Visual] = {}           # parked dressing body -> its look
+        self._dressing_poses: dict[str, tuple] = {}               # shown dressing object -> (position, yaw)
+        extra = dressing_instances(self.house, self.state.seed)
+        self.instances += extra
+        self._by_name.update({inst.name: inst for inst in extra})
+        self.dress(self.state.dressing, self.state.models)
+
+    def dress(self, level: str, models: Mapping[str, int]) -> None:
+        """Show the dressing of ``level`` as the layout for object ``models`` places it; every other
+        dressing body is parked out of the house like an open door's leaf (a body is made when first
+        shown and kept; its look leaves :attr:`visuals` while parked, so renderers skip it)."""
+        from ravh_sim.world.dressing import dressing
+        shown = {d.id: d for d in dressing(self.house, models, level, self.state.seed)}
+        c = self.client
+        for inst in self.instances:
+            if inst.kind != "dressing":
+                continue
+            placed = shown.get(inst.name)
+            if placed is None:
+                if inst.body >= 0 and inst.body in self.visuals:
+                    position, orientation = pb.getBasePositionAndOrientation(inst.body, physicsClientId=c)
+                    pb.resetBasePositionAndOrientation(inst.body, [*position[:2], position[2] - OPEN_DOOR_DROP],
+                                                       orientation, physicsClientId=c)
+                    self._dressing_visuals[inst.body] = self.visuals.pop(inst.body)
+                    self._dressing_poses.pop(inst.name, None)
+                continue
+            pose = (placed.position, placed.yaw)
+            if inst.body < 0:
+                inst.body = self._dressing_body(placed.placed(), placed.slot.collides)
+            elif self._dressing_poses.get(inst.name) != pose:     # (a body left as it is keeps its bits)
+                pb.resetBasePositionAndOrientation(inst.body, list(placed.position), quaternion_from_yaw(placed.yaw),
+                                                   physicsClientId=c)
+            self._dressing_poses[inst.name] = pose
+            if inst.body in self._dressing_visuals:
+                self.visuals[inst.body] = self._dressing_visuals.pop(inst.body)
+
+    def _dressing_body(self, placed: Placed, collides: bool) -> int:
+        """A dressing object's body: its fitted model, colliding as its triangles unless it does not."""
+        assert placed.model is not None
+        collision = self._model_collision(placed.model) if collides else -1
+        self.triangle_count += len(placed.model.faces)
+        if self._pybullet_draws:
+            drawn = palette_stand_in(placed.model)
+            path = self._asset(mesh_bytes(drawn), ".obj", lambda p: write_palette_obj(drawn, p, PALETTE))
+            body = self._new_body(collision, placed.position, placed.yaw, path)
+            self._set_look(body, self._texture("palette"), [1, 1, 1, 1])
+        else:
+            body = self._new_body(collision, placed.position, placed.yaw)
+        self.visuals[body] = Visual(model=placed.model)
+        return body
 
     # ------------------------------------------------------------------ poses
     def object_pose(self, name: str) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:

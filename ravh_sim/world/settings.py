@@ -17,7 +17,7 @@ import math
 import random
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, Field, create_model
 
@@ -124,6 +124,7 @@ class SettingsFile(Strict):
     doors: _Doors
     paint: _Paint
     models: _Models
+    dressing: Literal["none", "tidy", "lived-in"]
     agents: Annotated[list[_Agent], Field(max_length=MAX_AGENTS)]
 
 
@@ -192,6 +193,7 @@ def resolve(settings: dict[str, Any], house: House, seed: int | None = None,
         doors=_resolve_doors(doors_cfg, house, pick, source),
         paint=_resolve_paint(paint_cfg, house, pick, source),
         models=_resolve_models(models_cfg, house, pick, source),
+        dressing=settings.get("dressing", "none"),
         agents=_resolve_agents(settings.get("agents", []), house, source),
     )
 

@@ -16,7 +16,7 @@ from typing import Any
 
 from ravh_sim.world.settings import AgentSpec, Resolved
 
-LAYOUT_FIELDS = ("doors", "models")
+LAYOUT_FIELDS = ("doors", "models", "dressing")
 
 
 class WorldState:
@@ -57,6 +57,11 @@ class WorldState:
     @property
     def models(self) -> Mapping[str, int]:
         return self._now.models
+
+    @property
+    def dressing(self) -> str:
+        """none | tidy | lived-in (:mod:`ravh_sim.world.dressing`)."""
+        return self._now.dressing
 
     @property
     def agents(self) -> tuple[AgentSpec, ...]:

@@ -1,0 +1,241 @@
+"""Dressing (ravh_sim.world.dressing): seeded, reproducible from the footprint, every object resting on
+its support or hung on its wall and clear of its neighbours, as pybullet's own rays find them (not the
+placement code's numbers), big things colliding and rugs not, in masks, and changed at run time all or
+nothing."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pybullet as pb
+import pytest
+
+from ravh_msgs_py.appearance import parse
+from ravh_msgs_py.query import QueryError
+from ravh_sim.render.backend import resolve_backend
+from ravh_sim.robot.profile import load_profile
+from ravh_sim.sensors.camera import SmartCamera
+from ravh_sim.world import dressing as dressing_module
+from ravh_sim.world.appearance import Appearance
+from ravh_sim.world.dressing import dressing, slots
+from ravh_sim.world.footprint import load_footprint, make_footprint, write_footprint
+from ravh_sim.world.ground_truth import GroundTruth
+from ravh_sim.world.scene import World
+from ravh_sim.world.settings import load_settings, resolve
+from ravh_sim.world.state import WorldState
+
+HUNG = ("Picture", "Towel", "Curtain", "Blind")     # on a wall or at a window; the rest rest on something
+TOUCH_M = 0.004               # a support within this below an object's bottom (behind a hung one's back)
+INSIDE_M = 0.002              # nothing of a neighbour may reach this far into an object
+PROFILE = load_profile("giraff")
+
+
+def _settings(house, level: str, seed: int = 0):
+    cfg = load_settings()
+    cfg["dressing"] = level
+    return resolve(cfg, house, seed)
+
+
+def _rows(footprint: dict) -> list[dict]:
+    return [r for r in footprint["instances"] if r["kind"] == "dressing"]
+
+
+@pytest.mark.parametrize("number", [15, 23])
+def test_dressing_is_seeded_and_tidy_is_a_subset(houses, number):
+    house = houses[number]
+    lived = _rows(make_footprint(house, _settings(house, "lived-in")))
+    tidy = _rows(make_footprint(house, _settings(house, "tidy")))
+    assert lived and tidy and len(tidy) < len(lived)
+    assert all(r["dressing"] is True and "dressing" in r["tags"] for r in lived)
+    assert _rows(make_footprint(house, _settings(house, "lived-in"))) == lived      # same seed, same world
+    assert {json.dumps(r, sort_keys=True) for r in tidy} <= {json.dumps(r, sort_keys=True) for r in lived}
+    other = _rows(make_footprint(house, _settings(house, "lived-in", seed=5)))
+    assert [(r["name"], r["position"]) for r in other] != [(r["name"], r["position"]) for r in lived]
+    assert not _rows(make_footprint(house, _settings(house, "none")))
+    ids = {o.id for o in house.objects}
+    assert not ids & {r["name"] for r in lived}, "a dressing id repeats one of the house's"
+    first = max(r["id"] for r in make_footprint(house, _settings(house, "none"))["instances"])
+    assert min(r["id"] for r in lived) > first, "dressing instances come after the house's"
+
+
+def test_footprint_rebuilds_the_same_world(houses, tmp_path):
+    house = houses[15]
+    settings = _settings(house, "lived-in", seed=3)
+    path = tmp_path / "footprint.json"
+    write_footprint(make_footprint(house, settings), path)
+    number, again = load_footprint(path)
+    assert number == 15 and again.dressing == "lived-in"
+    assert make_footprint(house, again) == json.loads(path.read_text())
+    with World(house, again, renderer="tiny") as world:
+        for row in _rows(json.loads(path.read_text())):
+            position, _ = world.object_pose(row["name"])
+            assert np.allclose(position, row["position"], atol=2e-4)
+
+
+def test_a_record_without_dressing_is_the_bare_house(houses):
+    house = houses[15]
+    record = _settings(house, "lived-in").model_dump(mode="json")
+    del record["dressing"]
+    assert type(_settings(house, "none")).model_validate(record).dressing == "none"
+
+
+@pytest.fixture(scope="module")
+def dressed_world(houses):
+    house = houses[15]
+    with World(house, _settings(house, "lived-in"), renderer=resolve_backend("auto")) as world:
+        yield world
+
+
+def _quaternion(rot: np.ndarray) -> list[float]:
+    yaw = math.atan2(rot[1, 0], rot[0, 0])
+    return [0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)]
+
+
+def _frame(world: World, name: str):
+    (x, y, z), orn = world.object_pose(name)
+    rot = np.array(pb.getMatrixFromQuaternion(orn)).reshape(3, 3)
+    return np.array([x, y, z]), rot
+
+
+def test_every_dressing_object_rests_on_its_support_and_clear_of_neighbours(dressed_world):
+    """Rays through pybullet, each object hidden from its own rays: resting ones down through their
+    footprint from just under their top (the highest hit is within TOUCH_M under the bottom, and no
+    hit lies above it); hung ones from just behind their front towards the wall (the nearest hit
+    lies within TOUCH_M behind the back, none in front of it). Rugs have no collider: the floor."""
+    world = dressed_world
+    shown = [d for d in dressing(world.house, world.state.models, "lived-in", world.state.seed)]
+    assert len(shown) >= 10
+    failures = []
+    for d in shown:
+        centre, rot = _frame(world, d.id)
+        body = world.instance(d.id).body
+        # out of its own rays' way (ray_mask hides at most 23 bodies): parked below the house meanwhile
+        pb.resetBasePositionAndOrientation(body, [0, 0, -100], [0, 0, 0, 1], physicsClientId=world.client)
+        depth, width, height = d.slot.size
+        u = np.linspace(-depth / 2 + 0.003, depth / 2 - 0.003, 5)
+        v = np.linspace(-width / 2 + 0.003, width / 2 - 0.003, 5)
+        w = np.linspace(-height / 2 + 0.003, height / 2 - 0.003, 5)
+        if d.slot.type in HUNG:          # from the front (local +x) back along -x
+            grid = np.array([(depth / 2 - 0.001, b, c) for b in v for c in w])
+            starts = centre + grid @ rot.T
+            ends = starts - rot[:, 0] * 0.2
+            _, points = world.cast_rays(starts, ends)
+            gap = (points - starts) @ -rot[:, 0] - (depth - 0.001)       # distance behind the back
+        else:
+            grid = np.array([(a, b, height / 2 - 0.001) for a in u for b in v])
+            starts = centre + grid @ rot.T
+            ends = starts - np.array([0.0, 0.0, height + 0.2])
+            _, points = world.cast_rays(starts, ends)
+            gap = (centre[2] - height / 2) - points[:, 2]                    # distance below the bottom
+        pb.resetBasePositionAndOrientation(body, list(centre), _quaternion(rot),
+                                           physicsClientId=world.client)
+        gap = gap[np.isfinite(gap)]
+        if not len(gap) or gap.min() > TOUCH_M or gap.min() < -INSIDE_M:
+            failures.append((d.id, d.slot.support, float(gap.min()) if len(gap) else None))
+    assert not failures, f"floating or interpenetrating (id, support, nearest gap m): {failures}"
+
+
+def test_dressing_objects_do_not_overlap_each_other(dressed_world):
+    """No two dressing objects' boxes overlap (by more than INSIDE_M)."""
+    from shapely.geometry import Polygon
+    world = dressed_world
+    boxes = []
+    for d in dressing(world.house, world.state.models, "lived-in", world.state.seed):
+        (x, y, z), yaw = d.position, d.yaw
+        dx, dy, dz = (s / 2 - INSIDE_M for s in d.slot.size)
+        c, s = math.cos(yaw), math.sin(yaw)
+        corners = ((-dx, -dy), (dx, -dy), (dx, dy), (-dx, dy))
+        outline = Polygon([(x + c * a - s * b, y + s * a + c * b) for a, b in corners])
+        boxes.append((d.id, outline, z - dz, z + dz))
+    for i, (a, pa, a0, a1) in enumerate(boxes):
+        for b, pb_, b0, b1 in boxes[i + 1:]:
+            assert not (a0 < b1 and b0 < a1 and pa.intersects(pb_) and pa.intersection(pb_).area > 1e-6), (a, b)
+
+
+def test_big_things_collide_and_rugs_do_not(dressed_world):
+    world = dressed_world
+    for d in dressing(world.house, world.state.models, "lived-in", world.state.seed):
+        shapes = pb.getCollisionShapeData(world.instance(d.id).body, -1, physicsClientId=world.client)
+        assert bool(shapes) == (d.slot.type != "Rug"), d.id
+
+
+def test_masks_show_dressing_instances(dressed_world):
+    world = dressed_world
+    camera = SmartCamera(world, PROFILE.camera)
+    dressed = {world.instance(d.id).id: d for d in dressing(world.house, world.state.models, "lived-in",
+                                                            world.state.seed)}
+    seen: set[int] = set()
+    for d in list(dressed.values())[:12]:
+        x, y, _ = d.position
+        room = world.house.room(d.slot.room)
+        for k in range(12):
+            a = k * math.pi / 6
+            px, py = x + 1.4 * math.cos(a), y + 1.4 * math.sin(a)
+            if room.contains(px, py):
+                capture = camera.capture(px, py, a + math.pi)
+                seen |= set(np.unique(capture.instance).tolist()) & set(dressed)
+                break
+    camera.close()
+    assert len(seen) >= 3, "the camera shows dressing objects in its instance image"
+
+
+def test_ground_truth_marks_dressing_and_keeps_the_paper_counts(houses):
+    house = houses[15]
+    bare = GroundTruth(house, WorldState(_settings(house, "none")))
+    dressed = GroundTruth(house, WorldState(_settings(house, "lived-in")))
+    counts, bare_counts = dressed.answer({"query": "counts"})["result"], bare.answer({"query": "counts"})["result"]
+    assert counts["objects"] == bare_counts["objects"] and counts["objects_by_type"] == bare_counts["objects_by_type"]
+    assert counts["dressing"] > 0 and bare_counts["dressing"] == 0
+    tagged = dressed.answer({"query": "objects_with_tag", "tag": "dressing"})["result"]
+    assert len(tagged) == counts["dressing"] and all(o["dressing"] and o["support"] for o in tagged)
+    one = dressed.answer({"query": "object", "id": tagged[0]["id"]})
+    assert one["ok"] and one["result"]["instance_id"] == tagged[0]["instance_id"]
+
+
+def test_changing_dressing_at_run_time_is_all_or_nothing(houses, monkeypatch):
+    house = houses[15]
+    with World(house, _settings(house, "none"), renderer="tiny") as world:
+        appearance = Appearance(world)
+        assert not world.visuals.keys() & {i.body for i in world.instances if i.kind == "dressing"}
+        appearance.change(parse({"dressing": "lived-in"}))
+        assert world.state.dressing == "lived-in"
+        shown = {i.name for i in world.instances if i.kind == "dressing" and i.body in world.visuals}
+        assert shown == {r["name"] for r in _rows(make_footprint(house, world.state.settings()))}
+        appearance.change(parse({"dressing": "tidy"}))
+        tidy = {i.name for i in world.instances if i.kind == "dressing" and i.body in world.visuals}
+        assert tidy < shown
+        before = world.state.settings()
+        door = next(iter(before.doors))
+        real = World.dress
+
+        def broken(self, level, models):
+            if level == "lived-in":
+                raise RuntimeError("disk full")
+            real(self, level, models)
+
+        monkeypatch.setattr(World, "dress", broken)
+        with pytest.raises(RuntimeError):
+            appearance.change(parse({"dressing": "lived-in", "doors": {door: not before.doors[door]}}))
+        assert world.state.settings() == before
+        assert {i.name for i in world.instances if i.kind == "dressing" and i.body in world.visuals} == tidy
+        monkeypatch.setattr(World, "dress", real)
+        with pytest.raises(QueryError):
+            appearance.change(parse({"dressing": "messy"}))
+
+
+def test_slots_do_not_depend_on_models(houses):
+    house = houses[23]
+    settings = _settings(house, "lived-in")
+    assert slots(house, 0) == slots(house, 0)
+    ids = [s.id for s in slots(house, settings.seed)]
+    assert len(ids) == len(set(ids))
+    assert dressing_module.LEVELS == ("none", "tidy", "lived-in")
+
+
+def test_every_dressing_type_has_a_semantic_class():
+    from ravh_sim.dataset.coco import SEMANTIC_CLASSES
+    specs = [s for group in dressing_module.SUPPORTS.values() for s in group] + [
+        dressing_module.RUG, dressing_module.CURTAIN, dressing_module.BLIND, dressing_module.FLOOR_PLANT,
+        dressing_module.WALL_ART, dressing_module.TOWEL]
+    assert all(s.type in SEMANTIC_CLASSES for s in specs)
