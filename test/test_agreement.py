@@ -15,7 +15,6 @@ import pybullet as pb
 import pytest
 
 from ravh_sim.poses import matrix_from_quaternion, pose_matrix
-from ravh_sim.render.backend import resolve_backend
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.sensors.agreement import depth_beyond_laser, laser_beyond_depth, laser_minus_depth
 from ravh_sim.sensors.camera import SmartCamera
@@ -47,8 +46,7 @@ def test_laser_and_depth_agree_on_walls_objects_and_doors(houses, number):
     each furniture-library object seen from 2.8 m in front of it; all doors closed."""
     house = houses[number]
     settings = resolve(load_settings(), house)
-    with World(house, settings.changed(doors=dict.fromkeys(settings.doors, False)),
-               renderer=resolve_backend("auto")) as world:
+    with World(house, settings.changed(doors=dict.fromkeys(settings.doors, False))) as world:
         camera, laser = SmartCamera(world, PROFILE.camera), Laser(world, PROFILE.laser)
         poses = [(house.station.position[0], house.station.position[1], house.station.yaw)]
         for room in house.rooms:
@@ -97,7 +95,7 @@ def test_no_cracks_around_doors(houses, number):
     house = houses[number]
     settings = resolve(load_settings(), house)
     doors = {d.id: settings.doors[d.id] and len(d.rooms) == 2 for d in house.doors}
-    with World(house, settings.changed(doors=doors), renderer=resolve_backend("auto")) as world:
+    with World(house, settings.changed(doors=doors)) as world:
         camera = SmartCamera(world, PROFILE.camera)
         captures = 0
         for door in house.doors:
@@ -127,7 +125,7 @@ def test_every_wall_piece_stops_a_ray(houses):
     lost, uncounted = [], []
     for number in available_houses():
         house = houses[number]
-        with World(house, resolve(load_settings(), house), renderer="gl") as world:
+        with World(house, resolve(load_settings(), house)) as world:
             starts, ends, names = [], [], []
             for room in house.rooms:
                 body = world.instance(f"{room.id}/walls").body
@@ -162,8 +160,7 @@ def test_the_laser_stops_at_every_wall_the_depth_image_shows(houses, number):
     had dropped: 188 and 214 rays passed 0.1-3.6 m through them."""
     house = houses[number]
     settings = resolve(load_settings(), house)
-    with World(house, settings.changed(doors=dict.fromkeys(settings.doors, False)),
-               renderer=resolve_backend("auto")) as world:
+    with World(house, settings.changed(doors=dict.fromkeys(settings.doors, False))) as world:
         camera = SmartCamera(world, dataclasses.replace(PROFILE.camera, quality="fast"))
         laser = Laser(world, PROFILE.laser)
         names = {inst.id: inst.name for inst in world.instances}
@@ -246,7 +243,7 @@ def test_laser_and_depth_see_every_library_model_alike():
     holding whatever a model, a collider or the renderer becomes.)"""
     records = list(library.catalog().models)
     house, settings = _showroom(records)
-    with World(house, settings, renderer=resolve_backend("auto")) as world:
+    with World(house, settings) as world:
         camera = SmartCamera(world, dataclasses.replace(PROFILE.camera, quality="fast"))
         station = world.instance(house.station.object_id).id     # drawn, not solid: the robot starts on it
         checked: dict[str, int] = {}
@@ -290,7 +287,7 @@ def test_glass_is_opaque_to_the_laser_and_to_depth():
     records = [r for r in library.catalog().models if any(library.is_glass(m) for m in r.materials)]
     assert len(records) >= 10, [r.id for r in records]
     house, settings = _showroom(records)
-    with World(house, settings, renderer=resolve_backend("auto")) as world:
+    with World(house, settings) as world:
         camera = SmartCamera(world, dataclasses.replace(PROFILE.camera, quality="fast"))
         laser_checked, depth_checked, missed = set(), set(), []
         for record, obj in zip(records, house.objects):
