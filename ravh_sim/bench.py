@@ -46,7 +46,6 @@ def bench_load(houses: list[int] | None = None) -> dict[str, Any]:
     Baselines: the same build with an empty asset cache (first run on a machine), and a bare pybullet
     client with the renderer loaded (the fixed cost every build pays).
     """
-    from ravh_sim.render.backend import resolve_backend
     from ravh_sim.world.house import available_houses, load_house
     from ravh_sim.world.scene import World
     from ravh_sim.world.settings import load_settings, resolve
@@ -57,7 +56,7 @@ def bench_load(houses: list[int] | None = None) -> dict[str, Any]:
     def build(n: int) -> tuple[float, int]:
         def make() -> int:
             house = load_house(n)
-            world = World(house, resolve(settings, house), renderer=resolve_backend("auto"))
+            world = World(house, resolve(settings, house))
             tris = world.triangle_count
             world.close()
             return tris
@@ -132,7 +131,7 @@ def bench_nav(houses: list[int] | None = None) -> dict[str, Any]:
     map_times = [v["free_space_s"] for v in per_house.values()]
 
     house = load_house(NAV_HOUSE)
-    world = World(house, resolve(settings, house), renderer="tiny")
+    world = World(house, resolve(settings, house))
     try:
         empty = Simulation(world, agents=[])
         empty_step_s = _timed(lambda: empty.step(STEP_SAMPLES))[0] / STEP_SAMPLES
@@ -273,16 +272,15 @@ def bench_sensors(houses: list[int] | None = None) -> dict[str, Any]:
             if room.contains(cx, cy):
                 poses.append((cx, cy, i * math.pi / 2))
         for name, (backend, quality, with_sensor) in configs.items():
-            world = World(house, resolve(settings, house), renderer=resolve_backend(backend))
-            if world.renderer != backend:
-                world.close()
+            if resolve_backend(backend) != backend:
                 continue
+            world = World(house, resolve(settings, house))
             if name.endswith("night_all_lights"):
                 appearance = Appearance(world)
                 appearance.set_knob("sun_angle", "night")
                 appearance.set_lights("all", "on")
             spec = replace(profile.camera, quality=quality, sensor=with_sensor)
-            camera = PORT.build(world, spec, names.DEFAULT_AGENT)
+            camera = PORT.build(world, spec, names.DEFAULT_AGENT, backend)
             camera.capture(*poses[0])                         # shadow maps and buffers are made once
             times = [_timed(camera.capture, *pose)[0] * 1000
                      for _ in range(SENSOR_REPEATS) for pose in poses]

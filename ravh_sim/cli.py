@@ -24,7 +24,7 @@ from ravh_sim.nodes.launch import NODES
 from ravh_sim.nodes.launch import main as launch_node
 from ravh_sim.paths import FURNITURE_DIR, HOUSES_DIR
 from ravh_sim.raids.build import add_parser as add_dataset_parser
-from ravh_sim.render.backend import BACKENDS, resolve_backend
+from ravh_sim.render.backend import BACKENDS
 
 Command = Callable[[argparse.Namespace], int]
 
@@ -211,13 +211,13 @@ def cmd_render(args: argparse.Namespace) -> int:
     house, resolved = _resolved(args)
     pose = args.pose or (*house.station.position[:2], house.station.yaw)     # default: the robot's start
     house.room_at_or_raise(*pose[:2])                # an all-sky picture from outside helps nobody
-    with World(house, resolved, renderer=resolve_backend(args.renderer)) as world:
+    with World(house, resolved) as world:
         appearance = Appearance(world)
         if args.sun is not None:
             appearance.set_knob("sun_angle", _sun_value(args.sun))
         if args.lights is not None:
             appearance.set_lights("all", args.lights, args.seed)
-        camera = SmartCamera(world, load_profile(args.profile).camera)
+        camera = SmartCamera(world, load_profile(args.profile).camera, backend=args.renderer)
         paths = write_capture(camera, camera.capture(*pose), args.output)
     print("wrote " + ", ".join(str(p) for p in paths))
     return 0

@@ -109,13 +109,15 @@ class SimRuntime:
             self.house = house if isinstance(house, House) else load_house(house)
             resolved = resolve(load_settings(config), self.house, seed, str(config or "config/default.yaml"))
         self.initial = resolved
-        self.world = World(self.house, resolved, renderer=resolve_backend(renderer))
+        self.backend = resolve_backend(renderer)          # gl | tiny: what every camera here draws with
+        self.world = World(self.house, resolved)
         self.appearance = Appearance(self.world)
         self.sim = Simulation(self.world)
         self.agents = []
         for i, spec in enumerate(resolved.agents):
             profile = load_profile(spec.profile)
-            sensors = {port.name: port.build(self.world, profile.spec(port), spec.name) for port in SENSORS}
+            sensors = {port.name: port.build(self.world, profile.spec(port), spec.name, self.backend)
+                       for port in SENSORS}
             own = {ODOM: profile.odom_rate, **{port.name: port.rate(profile.spec(port)) for port in SENSORS}}
             agent_rates = {**own, **(rates or {})}
             schedules = {key: Schedule.every(rate, self.world.physics_hz) for key, rate in agent_rates.items()}

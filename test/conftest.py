@@ -46,7 +46,7 @@ def resolved(house, settings=None, seed=0):
 def world(houses):
     """House 15 built with the TinyRenderer, shared by a module's tests (a module may define its own)."""
     from ravh_sim.world.scene import World
-    with World(houses[15], resolved(houses[15]), renderer="tiny") as w:
+    with World(houses[15], resolved(houses[15])) as w:
         yield w
 
 

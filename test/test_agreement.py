@@ -15,7 +15,6 @@ import pybullet as pb
 import pytest
 
 from ravh_sim.poses import matrix_from_quaternion, pose_matrix
-from ravh_sim.render.backend import resolve_backend
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.sensors.agreement import depth_beyond_laser, laser_beyond_depth, laser_minus_depth
 from ravh_sim.sensors.camera import SmartCamera
@@ -47,8 +46,7 @@ def test_laser_and_depth_agree_on_walls_objects_and_doors(houses, number):
     each furniture-library object seen from 2.8 m in front of it; all doors closed."""
     house = houses[number]
     settings = resolve(load_settings(), house)
-    with World(house, settings.changed(doors=dict.fromkeys(settings.doors, False)),
-               renderer=resolve_backend("auto")) as world:
+    with World(house, settings.changed(doors=dict.fromkeys(settings.doors, False))) as world:
         camera, laser = SmartCamera(world, PROFILE.camera), Laser(world, PROFILE.laser)
         poses = [(house.station.position[0], house.station.position[1], house.station.yaw)]
         for room in house.rooms:
@@ -97,7 +95,7 @@ def test_no_cracks_around_doors(houses, number):
     house = houses[number]
     settings = resolve(load_settings(), house)
     doors = {d.id: settings.doors[d.id] and len(d.rooms) == 2 for d in house.doors}
-    with World(house, settings.changed(doors=doors), renderer=resolve_backend("auto")) as world:
+    with World(house, settings.changed(doors=doors)) as world:
         camera = SmartCamera(world, PROFILE.camera)
         captures = 0
         for door in house.doors:
@@ -127,7 +125,7 @@ def test_every_wall_piece_stops_a_ray(houses):
     lost, uncounted = [], []
     for number in available_houses():
         house = houses[number]
-        with World(house, resolve(load_settings(), house), renderer="gl") as world:
+        with World(house, resolve(load_settings(), house)) as world:
             starts, ends, names = [], [], []
             for room in house.rooms:
                 body = world.instance(f"{room.id}/walls").body
@@ -162,8 +160,7 @@ def test_the_laser_stops_at_every_wall_the_depth_image_shows(houses, number):
     had dropped: 188 and 214 rays passed 0.1-3.6 m through them."""
     house = houses[number]
     settings = resolve(load_settings(), house)
-    with World(house, settings.changed(doors=dict.fromkeys(settings.doors, False)),
-               renderer=resolve_backend("auto")) as world:
+    with World(house, settings.changed(doors=dict.fromkeys(settings.doors, False))) as world:
         camera = SmartCamera(world, dataclasses.replace(PROFILE.camera, quality="fast"))
         laser = Laser(world, PROFILE.laser)
         names = {inst.id: inst.name for inst in world.instances}
@@ -192,6 +189,13 @@ PLANE_FRACTIONS = (0.1, 0.25, 0.4, 0.55, 0.7, 0.85)           # laser heights, f
 _PREFABS = {"office": "Office chair", "small": "Small table", "tv": "TV stand", "vase": "Vase",
             "corner_upper": "Kitchen corner up", "corner": "Kitchen corner", "upper": "Kitchen up",
             "sink": "Kitchen sink", "stove": "Kitchen oven"}
+
+
+SHOWROOM_CHECK_M = 8.0
+"""Depth is checked against laser hits this near: the views stand 2.8 m from their model, and across the
+showroom (17 m: a pixel spans 3 cm there) a laser plane grazing the top of a far model's headboard falls
+between two pixel rows, the depth pixel seeing just over it (found when the library grew and a bed stood
+behind a wardrobe)."""
 
 
 def _showroom(records: list[library.LibraryRecord]):
@@ -224,7 +228,7 @@ def _showroom(records: list[library.LibraryRecord]):
         models[obj.id] = next(v for v in range(model_count(obj))
                               if library.record(object_parts(house, obj, v).model).id == record.id)
     settings = resolve(load_settings(), house)
-    return house, settings.changed(models={**settings.models, **models})
+    return house, settings.changed(models={**settings.models, **models}, dressing="none")
 
 
 def _views(house, world, obj):
@@ -244,9 +248,11 @@ def test_laser_and_depth_see_every_library_model_alike():
     (What was measured before: pybullet's ray test on every model's collider agrees with an exact
     ray-triangle test on its drawn triangles, so this holds on the library as it is; it keeps
     holding whatever a model, a collider or the renderer becomes.)"""
-    records = list(library.catalog().models)
+    # every model a house object can show; dressing models stand on furniture, not on the showroom's
+    # floor, and are checked where they stand (test_laser_and_depth_agree_on_walls_objects_and_doors)
+    records = [r for r in library.catalog().models if not r.kind.startswith("Dressing/")]
     house, settings = _showroom(records)
-    with World(house, settings, renderer=resolve_backend("auto")) as world:
+    with World(house, settings) as world:
         camera = SmartCamera(world, dataclasses.replace(PROFILE.camera, quality="fast"))
         station = world.instance(house.station.object_id).id     # drawn, not solid: the robot starts on it
         checked: dict[str, int] = {}
@@ -264,7 +270,7 @@ def test_laser_and_depth_see_every_library_model_alike():
                     checked[record.id] = checked.get(record.id, 0) + int(mine.sum())
                     beyond += [(record.id, pose, laser.spec.height, float(e))
                                for e in overshoot.excess[overshoot.beyond(BEYOND_M) & (overshoot.instance != station)]]
-                    through = depth_beyond_laser(laser, laser.scan(*pose), capture, pose, camera.spec.far)
+                    through = depth_beyond_laser(laser, laser.scan(*pose), capture, pose, SHOWROOM_CHECK_M)
                     run = through.beyond_in_runs(SEEN_THROUGH_M, SEEN_THROUGH_RUN)
                     seen_through += [(record.id, pose, laser.spec.height, int(b)) for b in through.beam[run]]
     assert not beyond, (len(beyond), beyond[:5])
@@ -287,10 +293,11 @@ def test_glass_is_opaque_to_the_laser_and_to_depth():
     a level laser ray aimed at the middle of a steep glass triangle ends there or before, and the
     depth image shows the middle of every glass triangle facing the camera there or before it.
     Clear glass is not in the library, so neither sensor has it (checked by the model tests above)."""
-    records = [r for r in library.catalog().models if any(library.is_glass(m) for m in r.materials)]
+    records = [r for r in library.catalog().models
+               if any(library.is_glass(m) for m in r.materials) and not r.kind.startswith("Dressing/")]
     assert len(records) >= 10, [r.id for r in records]
     house, settings = _showroom(records)
-    with World(house, settings, renderer=resolve_backend("auto")) as world:
+    with World(house, settings) as world:
         camera = SmartCamera(world, dataclasses.replace(PROFILE.camera, quality="fast"))
         laser_checked, depth_checked, missed = set(), set(), []
         for record, obj in zip(records, house.objects):

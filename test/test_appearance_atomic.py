@@ -40,7 +40,9 @@ def full_state(world: World) -> dict:
         visual = world.visuals.get(inst.body, Visual(paint="parked dressing"))
         bodies[inst.name] = (
             pb.getBasePositionAndOrientation(inst.body, physicsClientId=c),
-            pb.getCollisionShapeData(inst.body, -1, physicsClientId=c),
+            # the shapes' geometry, size, file and frame (pybullet leaves a compound child's body
+            # and link fields uninitialised, so those vary between calls)
+            tuple(shape[2:] for shape in pb.getCollisionShapeData(inst.body, -1, physicsClientId=c)),
             tuple(v[:8] for v in pb.getVisualShapeData(inst.body, physicsClientId=c)),
             visual.paint, visual.surface, None if visual.mesh is None else len(visual.mesh.faces))
     return {"settings": world.state.settings(), "revisions": (world.state.revision, world.state.layout_revision),
@@ -140,7 +142,7 @@ def test_inherited_models_that_do_not_exist_wrap_round(houses):
 def test_200_seeds_of_randomise_all_succeed(houses):
     """200 seeds of ``randomise`` applied, spread over four houses with cross-type inheritance links:
     every one succeeds and leaves the state it reports."""
-    worlds = {n: World(houses[n], resolved(houses[n]), renderer="tiny") for n in (15, 24, 5, 17)}
+    worlds = {n: World(houses[n], resolved(houses[n])) for n in (15, 24, 5, 17)}
     try:
         for i, seed in enumerate(SEEDS):
             world = list(worlds.values())[i % len(worlds)]

@@ -34,7 +34,7 @@ CONTROL_STEPS = 12          # 20 Hz control at 240 Hz physics
 def rig(houses):
     def make(n: int):
         house = houses[n]
-        world = World(house, resolved(house), renderer="tiny")
+        world = World(house, resolved(house))
         sim = Simulation(world)
         robot = sim.robot("robot")
         nav = Navigation(house, world.state, robot.profile)

@@ -13,7 +13,6 @@ import pytest
 
 from ravh_msgs_py.appearance import parse
 from ravh_msgs_py.query import QueryError
-from ravh_sim.render.backend import resolve_backend
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.sensors.camera import SmartCamera
 from ravh_sim.world import dressing as dressing_module
@@ -67,7 +66,7 @@ def test_footprint_rebuilds_the_same_world(houses, tmp_path):
     number, again = load_footprint(path)
     assert number == 15 and again.dressing == "lived-in"
     assert make_footprint(house, again) == json.loads(path.read_text())
-    with World(house, again, renderer="tiny") as world:
+    with World(house, again) as world:
         for row in _rows(json.loads(path.read_text())):
             position, _ = world.object_pose(row["name"])
             assert np.allclose(position, row["position"], atol=2e-4)
@@ -83,7 +82,7 @@ def test_a_record_without_dressing_is_the_bare_house(houses):
 @pytest.fixture(scope="module")
 def dressed_world(houses):
     house = houses[15]
-    with World(house, _settings(house, "lived-in"), renderer=resolve_backend("auto")) as world:
+    with World(house, _settings(house, "lived-in")) as world:
         yield world
 
 
@@ -195,7 +194,7 @@ def test_ground_truth_marks_dressing_and_keeps_the_paper_counts(houses):
 
 def test_changing_dressing_at_run_time_is_all_or_nothing(houses, monkeypatch):
     house = houses[15]
-    with World(house, _settings(house, "none"), renderer="tiny") as world:
+    with World(house, _settings(house, "none")) as world:
         appearance = Appearance(world)
         assert not world.visuals.keys() & {i.body for i in world.instances if i.kind == "dressing"}
         appearance.change(parse({"dressing": "lived-in"}))

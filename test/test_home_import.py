@@ -123,7 +123,7 @@ def test_the_world_builds_with_the_homes_own_models(imported):
     lo, hi = placed.extent()
     assert hi - lo == pytest.approx(bed.size, abs=1e-6)                  # stretched to its box
     assert model_count(bed) >= 2                                         # and the library's beds after it
-    with World(house, resolved(house), renderer="tiny") as world:
+    with World(house, resolved(house)) as world:
         assert world.house.name == "tiny"
 
 

@@ -191,7 +191,7 @@ def test_light_maps_follow_a_door_or_model_change(world, appearance, change, doo
     appearance.set_knob("sun_angle", "night")
     appearance.set_lights("all", "off")
     appearance.set_light(lit, True)
-    with World(world.house, world.state.settings(), renderer=world.renderer) as changing:
+    with World(world.house, world.state.settings()) as changing:
         camera = _camera_over(changing)                  # one renderer, before and after the change
         try:
             first = TopDown(camera, 7.6, 2.6)
@@ -200,7 +200,7 @@ def test_light_maps_follow_a_door_or_model_change(world, appearance, change, doo
         finally:
             camera.close()
         after = changing.state.settings()
-    with World(world.house, after, renderer=world.renderer) as fresh:
+    with World(world.house, after) as fresh:
         camera = _camera_over(fresh)
         try:
             expected = TopDown(camera, 7.6, 2.6)

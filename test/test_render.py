@@ -196,7 +196,7 @@ def test_each_house_looks_out_on_its_own_neighbourhood(world, appearance):
     appearance.set_knob("sun_angle", "day")
     first = _pane(world, _ideal(world).capture(*VIEW_WINDOW))
     neighbour = replace(world.house, number=world.house.number + 1)
-    with _world(neighbour, "gl") as other:
+    with _world(neighbour) as other:
         Appearance(other).set_knob("sun_angle", "day")
         elsewhere = _pane(other, _ideal(other).capture(*VIEW_WINDOW))
     again = _pane(world, _ideal(world).capture(*VIEW_WINDOW))

@@ -50,7 +50,7 @@ def make_world(houses, default_settings):
         settings = resolve(default_settings, house)
         if agents is not None:
             settings = settings.changed(agents=tuple(agents))
-        world = World(house, settings, renderer="tiny")
+        world = World(house, settings)
         made.append(world)
         return world
 

@@ -30,7 +30,7 @@ DEPTH_M = 2.0
 def renderer(houses):
     if resolve_backend("auto") != "gl":
         pytest.fail("the GL renderer must start on this machine (EGL + llvmpipe)")
-    with World(houses[20], resolved(houses[20]), renderer="gl") as world:
+    with World(houses[20], resolved(houses[20])) as world:
         gl = GLRenderer(world, K, W, H, 0.15, 20.0)
         yield gl
         gl.release()
@@ -131,7 +131,7 @@ def test_the_robots_camera_develops_on_the_device_and_blurs_when_it_turns(houses
     """The giraff camera as the sim builds it: its frames come developed by the renderer (no numpy
     sensor), and its sensor blurs them whenever the robot moves (no profile switch needed)."""
     house = houses[15]
-    with World(house, resolved(house), renderer="gl") as world:
+    with World(house, resolved(house)) as world:
         camera = PORT.build(world, load_profile().camera, "robot")
         x, y, yaw = house.station.position[0], house.station.position[1], house.station.yaw
         still = camera.capture(x, y, yaw, index=0)

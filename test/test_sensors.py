@@ -106,11 +106,10 @@ def box_house():
     return _box_house()
 
 
-def _world(house, renderer="auto", seed=0):
+def _world(house, seed=0):
     """The house with the default settings, undressed: these tests measure sensors against its known
     walls and objects (dressing has tests of its own, test_dressing.py)."""
-    settings = resolve(load_settings(), house, seed).changed(dressing="none")
-    return World(house, settings, renderer=resolve_backend(renderer))
+    return World(house, resolve(load_settings(), house, seed).changed(dressing="none"))
 
 
 @pytest.fixture(scope="module")
@@ -122,7 +121,7 @@ def world(box_house):
 def gl_box_world():
     """The box house drawn by the GL renderer (tests of light need its shading, not the TinyRenderer's)."""
     with _world(_box_house()) as w:
-        if w.renderer != "gl":
+        if resolve_backend("auto") != "gl":
             pytest.fail("the GL renderer must start on this machine (EGL + llvmpipe)")
         yield w
 
@@ -178,8 +177,8 @@ def test_projection_matrix_maps_K_pixels_to_ndc():
 def test_points_projected_with_K_land_where_they_render(renderer, world, box_house):
     """Edges of known geometry fall within half a pixel of where K puts them, sub-pixel shifts
     included (the floor is raised by fractions of a pixel)."""
-    with (_world(box_house, "tiny") if renderer == "tiny" else contextlib.nullcontext(world)) as w:
-        camera = SmartCamera(w, PROFILE.camera)
+    with (_world(box_house) if renderer == "tiny" else contextlib.nullcontext(world)) as w:
+        camera = SmartCamera(w, PROFILE.camera, backend=renderer)
         a_walls, a_floor, b_walls = (w.instance(n).id for n in ("A/walls", "A/floor", "B/walls"))
         for lift in np.linspace(0.0, 0.006, 4):
             # Where room A's floor meets its east wall (x = 6), at y = 3.3: wall above, floor below.
@@ -343,7 +342,7 @@ def test_scans_of_a_drive_equal_a_replay_without_the_robot(houses, number):
     """The robot's own body never shortens or lengthens a beam: every scan of a drive through the
     house equals, beam for beam, a scan from the same pose in the same world with the robot gone.
     (Beams used to restart from the robot's base-link box at the map origin and pass walls.)"""
-    with World(houses[number], resolve(load_settings(), houses[number]), renderer="tiny") as world:
+    with World(houses[number], resolve(load_settings(), houses[number])) as world:
         robot, scans = _drive_and_scan(world, rooms=3)
         pb.removeBody(robot.body, physicsClientId=world.client)
         replay = Laser(world, PROFILE.laser)
@@ -359,7 +358,7 @@ def test_the_laser_sees_between_legs(houses):
     rays crossing each one's box (at 9 offsets along each axis) hit it exactly where an independent
     ray/triangle intersection with the drawn model says, and some pass between the legs."""
     house = houses[15]
-    with World(house, resolve(load_settings(), house), renderer="tiny") as world:
+    with World(house, resolve(load_settings(), house)) as world:
         checked, passed_between = 0, 0
         for obj in house.objects:
             box = obj.box(world.state.models[obj.id])
@@ -569,8 +568,8 @@ def test_same_seed_and_pose_give_identical_images_and_scans(box_house):
     laser_spec = replace(PROFILE.laser, noise_sigma=0.01)
     runs = []
     for seed in (5, 5, 6):
-        with _world(box_house, "tiny", seed) as w:
-            cam, laser = SmartCamera(w, PROFILE.camera, options), Laser(w, laser_spec)
+        with _world(box_house, seed) as w:
+            cam, laser = SmartCamera(w, PROFILE.camera, options, backend="tiny"), Laser(w, laser_spec)
             runs.append([(cam.capture(2.0, 2.0, 0.3), laser.scan(2.0, 2.0, 0.3)) for _ in range(2)])
     (a1, s1), (a2, s2) = runs[0]
     (b1, t1), _ = runs[1]
@@ -585,8 +584,8 @@ def test_each_agent_has_its_own_noise(box_house):
     """Same seed, pose and frame counter: one agent's sensors repeat exactly, two agents' differ."""
     options = CameraOptions(pixel_noise=3.0, depth_noise=0.002)
     laser_spec = replace(PROFILE.laser, noise_sigma=0.01)
-    with _world(box_house, "tiny", 5) as w:
-        reads = [(SmartCamera(w, PROFILE.camera, options, agent).capture(2.0, 2.0, 0.3),
+    with _world(box_house, 5) as w:
+        reads = [(SmartCamera(w, PROFILE.camera, options, agent, backend="tiny").capture(2.0, 2.0, 0.3),
                   Laser(w, laser_spec, agent).scan(2.0, 2.0, 0.3)) for agent in ("alpha", "beta", "alpha")]
     (a, sa), (b, sb), (a_again, sa_again) = reads
     assert a.index == b.index == a_again.index == 0 and sa.index == sb.index == 0
@@ -600,9 +599,10 @@ def test_tiny_renderer_fallback_sees_the_same_geometry(box_house, camera):
     """The fallback looks plainer (no shadows, no materials) but sees the same scene from the same K."""
     pose = (3.0, 1.5, 0.3)
     gl = camera.capture(*pose)
-    with _world(box_house, "tiny") as w:
-        assert w.renderer == "tiny"
-        tiny = SmartCamera(w, PROFILE.camera).capture(*pose)
+    with _world(box_house) as w:
+        tiny_camera = SmartCamera(w, PROFILE.camera, backend="tiny")
+        assert tiny_camera.backend == "tiny"
+        tiny = tiny_camera.capture(*pose)
     assert (gl.instance == tiny.instance).mean() > 0.99
     both = np.isfinite(gl.depth) & np.isfinite(tiny.depth)
     assert np.median(np.abs(gl.depth[both] - tiny.depth[both])) < 0.01

@@ -8,16 +8,16 @@ import pybullet as pb
 import pytest
 from conftest import resolved
 
-from ravh_sim.render.backend import resolve_backend
 from ravh_sim.world.appearance import Appearance
 from ravh_sim.world.footprint import build_instances, dressing_instances, make_footprint
+from ravh_sim.world.library import record
 from ravh_sim.world.scene import World
 from ravh_sim.world.solids import model_count, object_parts
 
 
 def test_every_house_builds_with_one_body_per_labelled_object(houses):
     for n, house in houses.items():
-        with World(house, resolved(house), renderer="tiny") as world:
+        with World(house, resolved(house)) as world:
             objects = [i for i in world.instances if i.kind in ("object", "door", "window")]
             assert len(objects) == len(house.objects), n
             # a dressing object the layout leaves out has no body (ravh_sim.world.dressing)
@@ -29,12 +29,12 @@ def test_every_house_builds_with_one_body_per_labelled_object(houses):
 
 
 def test_house_23_geometry_budget(houses):
-    with World(houses[23], resolved(houses[23]), renderer="tiny") as world:
+    with World(houses[23], resolved(houses[23])) as world:
         assert 0 < world.triangle_count < 200_000
 
 
 def test_instances_match_the_pure_instance_table(houses):
-    with World(houses[15], resolved(houses[15]), renderer="tiny") as world:
+    with World(houses[15], resolved(houses[15])) as world:
         assert [(i.id, i.name, i.mask_color) for i in world.instances] == \
                [(i.id, i.name, i.mask_color) for i in build_instances(houses[15])
                 + dressing_instances(houses[15], world.state.seed)]
@@ -44,7 +44,7 @@ def test_collision_boxes_fit_the_object_boxes(houses):
     house = houses[20]
     settings = resolved(house)
     filled = []
-    with World(house, settings, renderer="tiny") as world:
+    with World(house, settings) as world:
         for obj in house.objects:
             if obj.type in ("Door", "Station"):
                 continue
@@ -59,7 +59,7 @@ def test_collision_boxes_fit_the_object_boxes(houses):
 
 def test_doors_open_and_close_at_run_time(houses):
     house = houses[15]
-    with World(house, resolved(house), renderer="tiny") as world:
+    with World(house, resolved(house)) as world:
         door, appearance = house.doors[0], Appearance(world)
         appearance.set_door(door.id, False)
         closed_z = world.object_pose(door.id)[0][2]
@@ -80,20 +80,36 @@ def test_doors_open_and_close_at_run_time(houses):
 def test_model_swap_rebuilds_the_body(houses):
     house = houses[15]
     settings = resolved(house)
-    with World(house, settings, renderer="tiny") as world:
+    with World(house, settings) as world:
         inst = world.instance("Bed_0")
-        before = pb.getVisualShapeData(inst.body, physicsClientId=world.client)[0][4]
+        before, shown = inst.body, record(world.visuals[inst.body].model).id
         Appearance(world).set_object_model("Bed_0", (settings.models["Bed_0"] + 1) % 3)
-        after = pb.getVisualShapeData(world.instance("Bed_0").body, physicsClientId=world.client)[0][4]
-        assert before != after
+        after = world.instance("Bed_0").body
+        assert after != before and before not in world.visuals
+        assert record(world.visuals[after].model).id != shown
         assert world.body_to_instance_lut()[world.instance("Bed_0").body] == inst.id
 
 
-def test_the_world_is_drawn_by_the_backend_its_builder_resolved(houses):
-    with World(houses[20], resolved(houses[20]), renderer=resolve_backend("auto")) as world:
-        assert world.renderer in ("gl", "tiny")
-    with pytest.raises(ValueError, match="resolved backend"):
-        World(houses[20], resolved(houses[20]), renderer="auto")
+def test_the_world_has_no_visual_shapes_of_its_own(houses):
+    """The World's bodies only collide; the TinyRenderer draws its own visual-only mirror of them, and
+    leaves the world's bodies (which pybullet would draw as their collision shapes) out of its images."""
+    from ravh_sim.render.tiny_scene import TinyScene
+    with World(houses[20], resolved(houses[20])) as world:
+        shown = [inst for inst in world.instances if inst.body in world.visuals]     # dressing: some unshown
+        bodies = [world.ground, *(inst.body for inst in shown)]
+        before = pb.getNumBodies(physicsClientId=world.client)
+        scene = TinyScene.of(world)
+        assert TinyScene.of(world) is scene                  # one mirror a world, however many cameras
+        mirrored = pb.getNumBodies(physicsClientId=world.client) - before
+        assert mirrored == len(world.visuals) > 0
+        for body in bodies:
+            assert all(shape[7][3] == 0.0 for shape in pb.getVisualShapeData(body, physicsClientId=world.client))
+        for inst in shown:
+            mirror = next(b for b, i in enumerate(scene.lut) if i == inst.id)
+            hit = pb.getVisualShapeData(mirror, physicsClientId=world.client)
+            assert len(hit) == 1 and hit[0][7][3] == 1.0
+            assert np.allclose(pb.getBasePositionAndOrientation(mirror, physicsClientId=world.client)[0],
+                               pb.getBasePositionAndOrientation(inst.body, physicsClientId=world.client)[0])
 
 
 def test_every_variant_of_every_object_lies_in_its_footprint_box(houses):

@@ -75,7 +75,7 @@ class SimNode(Node):
                                                     rates=p.rates, footprint=p.footprint)
         self.get_logger().info(
             f"house {rt.house.number}: {len(rt.house.rooms)} rooms, {len(rt.house.objects)} objects, "
-            f"renderer {rt.world.renderer}, seed {rt.world.state.seed}, real-time factor {p.rtf:g}")
+            f"renderer {rt.backend}, seed {rt.world.state.seed}, real-time factor {p.rtf:g}")
         self.topics = SimTopics(self, rt)
         self.health = SimHealth(p.rtf, self.get_logger().warning)
         self.budget = AppearanceBudget()

@@ -14,7 +14,6 @@ import cv2
 import numpy as np
 
 from ravh_sim.raids.raid import PRESETS, preset_settings
-from ravh_sim.render.backend import resolve_backend
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.sensors.camera import SmartCamera
 from ravh_sim.viz.figure import figure_bgr, new_figure
@@ -61,13 +60,13 @@ def gallery(house_number: int, output: Path, seed: int = 0,
     """Write the contact sheet (3 x 2 panels) to ``output``; returns it."""
     house = load_house(house_number)
     profile = load_profile()
-    with World(house, _preset(house, 0, seed), renderer=resolve_backend(renderer)) as world:
+    with World(house, _preset(house, 0, seed)) as world:
         appearance = Appearance(world)
         if pose is None:
-            scout = SmartCamera(world, replace(profile.camera, quality="fast"))
+            scout = SmartCamera(world, replace(profile.camera, quality="fast"), backend=renderer)
             pose = best_view(world, scout)
             scout.close()
-        camera = SmartCamera(world, profile.camera)
+        camera = SmartCamera(world, profile.camera, backend=renderer)
         panels = []
         for k, preset in enumerate(PRESETS):
             appearance.apply(_preset(house, k, seed))
@@ -144,12 +143,12 @@ def object_gallery(house_number: int, output: Path, seed: int = 0, renderer: str
     look) and at night with the lights on (raid 4's), side by side."""
     house = load_house(house_number)
     profile = load_profile()
-    with World(house, _preset(house, 0, seed), renderer=resolve_backend(renderer)) as world:
+    with World(house, _preset(house, 0, seed)) as world:
         appearance = Appearance(world)
-        scout = SmartCamera(world, replace(profile.camera, quality="fast"))
+        scout = SmartCamera(world, replace(profile.camera, quality="fast"), backend=renderer)
         views = object_views(world, scout)
         scout.close()
-        camera = SmartCamera(world, profile.camera)
+        camera = SmartCamera(world, profile.camera, backend=renderer)
         panels: dict[str, list[np.ndarray]] = {name: [] for name, _ in views}
         for raid, look in ((0, "day"), (4, "night")):
             appearance.apply(_preset(house, raid, seed))

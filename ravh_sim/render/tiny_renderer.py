@@ -1,8 +1,9 @@
 """pybullet's TinyRenderer, the fallback where no GL context can be made (and the speed baseline).
 
-pybullet draws the World's bodies with one directional light (the sun's direction) and fixed shading;
-:mod:`tiny_lighting` then adds daylight colour and the switched-on lamps per room, and the sky fills
-the background; what shines is the scene's light model's (:func:`ravh_sim.look.lighting.scene_lights`).
+pybullet draws the house's visual mirror (:mod:`tiny_scene`) with one directional light (the sun's
+direction) and fixed shading; :mod:`tiny_lighting` then adds daylight colour and the switched-on lamps
+per room, and the sky fills the background; what shines is the scene's light model's
+(:func:`ravh_sim.look.lighting.scene_lights`).
 TinyRenderer samples pixel corners and flips rows one pixel off, so its projection is built from K with
 that sample offset and its pixels still match K exactly.
 """
@@ -15,6 +16,7 @@ import pybullet as pb
 from ravh_sim.look.lighting import scene_lights
 from ravh_sim.render.projection import projection_from_K, view_matrix
 from ravh_sim.render.tiny_lighting import SUN_AMBIENT, SUN_DIFFUSE, Lighting
+from ravh_sim.render.tiny_scene import TinyScene
 from ravh_sim.render.views import Development, RenderedViews
 from ravh_sim.world.scene import World
 
@@ -33,12 +35,14 @@ class TinyRenderer:
         u, v = np.meshgrid(np.arange(width) + 0.5, np.arange(height) + 0.5)
         self._rays = np.stack([u, v, np.ones_like(u)], axis=-1) @ np.linalg.inv(K).T   # optical frame
         self._rays /= np.linalg.norm(self._rays, axis=-1, keepdims=True)
+        self.scene = TinyScene.of(world)
 
     def render(self, position: np.ndarray, rotation: np.ndarray, exposure: float | None = None,
                radiance: bool = False, development: Development | None = None) -> RenderedViews:
         """Views from an optical pose; ``exposure`` is ignored (the lighting pass sets the level), and
         so are ``radiance`` and ``development`` (no linear light: the camera develops the 8-bit image
         through its sensor model)."""
+        self.scene.sync()
         scene = scene_lights(self.world.house, self.world.state)
         sun = scene.sun
         view = view_matrix(position, rotation)
@@ -53,8 +57,7 @@ class TinyRenderer:
         background = seg < 0
         depth = (self.far * self.near) / (self.far - (self.far - self.near) * buffer)
         depth[background | (buffer >= 1.0)] = np.nan
-        lut = np.append(self.world.body_to_instance_lut(), 0).astype(np.uint16)  # seg -1 -> last entry
-        instance = np.take(lut, seg, mode="wrap")
+        instance = np.take(self.scene.lut, seg, mode="wrap")           # seg -1 -> the last entry, 0
         rgb = self.lighting.apply(cv2.cvtColor(rgba, cv2.COLOR_RGBA2RGB), depth, instance, rotation,
                                   position, sun, list(scene.lamps))
         if background.any():
@@ -73,4 +76,4 @@ class TinyRenderer:
         return np.clip(colour, 0.0, 255.0).astype(np.uint8)
 
     def release(self) -> None:
-        """Nothing to free: pybullet's client belongs to the World."""
+        """Nothing to free: the mirror's bodies live in the World's client and go with it."""

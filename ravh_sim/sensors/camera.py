@@ -27,7 +27,7 @@ from pydantic import Field, model_validator
 from ravh_msgs_py import names
 from ravh_sim.files import atomic_write, encode_png, read_png, write_image
 from ravh_sim.poses import quaternion_from_matrix
-from ravh_sim.render.backend import QUALITIES
+from ravh_sim.render.backend import QUALITIES, resolve_backend
 from ravh_sim.render.renderers import make_renderer
 from ravh_sim.render.views import Development, Exposure, Renderer, typical_depth
 from ravh_sim.schema import FINITE, Length, Range, Rate, Strict
@@ -198,8 +198,11 @@ class SmartCamera:
     """A camera mounted on a robot, rendering one World."""
 
     def __init__(self, world: World, spec: CameraSpec, options: CameraOptions | None = None,
-                 agent: str = names.DEFAULT_AGENT, sensor: imaging.SensorModel | None = None) -> None:
+                 agent: str = names.DEFAULT_AGENT, sensor: imaging.SensorModel | None = None,
+                 backend: str = "auto") -> None:
+        """``backend``: the renderer, auto | gl | tiny (:func:`ravh_sim.render.backend.resolve_backend`)."""
         self.world, self.spec, self.agent = world, spec, agent
+        self.backend = resolve_backend(backend)
         self.options = options or CameraOptions()
         self.sensor = sensor                        # None: the ideal camera (the renderer's exposure)
         self.width, self.height = spec.width, spec.height_px
@@ -207,8 +210,8 @@ class SmartCamera:
         self.camera_info = self._camera_info()
         self._lens = (imaging.LensDistortion(self.K, self.options.distortion, self.width, self.height)
                       if self.options.distortion is not None else None)
-        self.renderer: Renderer | None = make_renderer(world, self.K, self.width, self.height, spec.near,
-                                                       spec.far, spec.quality)
+        self.renderer: Renderer | None = make_renderer(world, self.backend, self.K, self.width, self.height,
+                                                       spec.near, spec.far, spec.quality)
         self._instance_rgb = np.zeros((max(i.id for i in world.instances) + 1, 3), np.uint8)
         for inst in world.instances:
             self._instance_rgb[inst.id] = inst.mask_color
@@ -323,7 +326,7 @@ def write_capture(camera: SmartCamera, capture: Capture, directory: Path) -> lis
     visible = [{"id": int(i), "name": by_id[i].name, "kind": by_id[i].kind, "type": by_id[i].type,
                 "room": by_id[i].room, "mask_color": list(by_id[i].mask_color), "pixels": int(counts[i])}
                for i in np.argsort(-counts) if i in by_id and counts[i] > 0]
-    info = {"house": camera.world.house.number, "renderer": camera.world.renderer,
+    info = {"house": camera.world.house.number, "renderer": camera.backend,
             "robot_pose": list(capture.robot_pose), "frame_id": capture.camera_info.frame_id,
             "camera_position": [float(v) for v in capture.position],
             "camera_orientation": list(capture.orientation), "K": capture.K.tolist(),
@@ -378,8 +381,8 @@ class CameraPort(SensorPort[CameraSpec, SmartCamera, Capture]):
                  quaternion_from_matrix(mount_rotation(0.0, math.radians(cam.pitch_deg)))),
                 (names.CAMERA_FRAME, names.CAMERA_OPTICAL_FRAME, (0.0, 0.0, 0.0), OPTICAL_ROTATION)]
 
-    def build(self, world: World, spec: CameraSpec, agent: str) -> SmartCamera:
-        return SmartCamera(world, spec, CameraOptions(**dict(spec.effects)), agent, spec.sensor)
+    def build(self, world: World, spec: CameraSpec, agent: str, backend: str = "auto") -> SmartCamera:
+        return SmartCamera(world, spec, CameraOptions(**dict(spec.effects)), agent, spec.sensor, backend)
 
     def read(self, sensor: SmartCamera, carrier: Carrier) -> Capture:
         x, y, yaw = carrier.pose

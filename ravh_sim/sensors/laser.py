@@ -188,7 +188,7 @@ class LaserPort(SensorPort[LaserSpec, Laser, Scan]):
         return [(names.BASE_FRAME, names.LASER_FRAME, tuple(mount_position(0.0, 0.0, 0.0, 0.0, spec.height)),
                  quaternion_from_matrix(mount_rotation(0.0)))]
 
-    def build(self, world: World, spec: LaserSpec, agent: str) -> Laser:
+    def build(self, world: World, spec: LaserSpec, agent: str, backend: str = "auto") -> Laser:
         return Laser(world, spec, agent)
 
     def read(self, sensor: Laser, carrier: Carrier) -> Scan:

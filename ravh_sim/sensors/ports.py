@@ -89,8 +89,9 @@ class SensorPort(ABC, Generic[SpecT, SensorT, DataT]):
         """Its frames on base_link (floor level)."""
 
     @abstractmethod
-    def build(self, world: World, spec: SpecT, agent: str) -> SensorT:
-        """The sensor of agent ``agent``."""
+    def build(self, world: World, spec: SpecT, agent: str, backend: str = "auto") -> SensorT:
+        """The sensor of agent ``agent``; ``backend``: the renderer backend a sensor that draws uses
+        (auto | gl | tiny, :mod:`ravh_sim.render.backend`)."""
 
     @abstractmethod
     def read(self, sensor: SensorT, carrier: Carrier) -> DataT:

@@ -9,12 +9,11 @@ The World owns the live :class:`~ravh_sim.world.state.WorldState` (:attr:`World.
 the settings) but does not write it: :class:`ravh_sim.world.appearance.Appearance` does, moving bodies
 through the primitives here (:meth:`World.place_door`, :meth:`World.load_model`, :meth:`World.repaint`).
 
-It also keeps what every body looks like (:attr:`World.visuals`: the mesh, its paint); a renderer
-(ravh_sim.render) rebuilds its GPU copy of the house only when the state says doors, models or paint
-changed (:meth:`WorldState.changed_since`). pybullet's own renderer is used only
-by the TinyRenderer fallback; the EGL plugin is never loaded (one GL context per process belongs to
-ravh_sim.render). The World sits below its renderers: whoever builds it picks the backend
-(:func:`ravh_sim.render.backend.resolve_backend`) and tells it which one will draw it.
+It also keeps what every body looks like (:attr:`World.visuals`: the mesh, its paint), as data: its
+bodies have collision shapes only, and no renderer is known here. Renderers (ravh_sim.render) build
+their own copy of the house from the visuals and redo it when the state says doors, models or paint
+changed (ravh_sim.look.changes); the EGL plugin is never loaded (one GL context per process belongs to
+ravh_sim.render).
 """
 from __future__ import annotations
 
@@ -27,22 +26,19 @@ from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-import cv2
 import numpy as np
 import pybullet as pb
 import trimesh
 
 from ravh_sim.poses import quaternion_from_yaw
-from ravh_sim.world import paints
 from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances, dressing_instances
 from ravh_sim.world.house import House, HouseObject, Wall
-from ravh_sim.world.library import palette_stand_in, record
-from ravh_sim.world.mesh import colours, hulls_obj_text, write_palette_obj
-from ravh_sim.world.palette import PALETTE
+from ravh_sim.world.library import record
+from ravh_sim.world.mesh import hulls_obj_text
 from ravh_sim.world.settings import Resolved
 from ravh_sim.world.solids import Placed, door_pose, object_parts
 from ravh_sim.world.state import WorldState
-from ravh_sim.world.structure import floor_mesh, solid_walls, wall_mesh, write_textured_obj
+from ravh_sim.world.structure import floor_mesh, solid_walls, wall_mesh
 
 NON_SOLID_TYPES = frozenset({"Station"})      # drawn, but the robot starts on it
 OPEN_DOOR_DROP = 50.0                          # m an open door's leaf sinks, out of every sensor's view
@@ -68,6 +64,16 @@ def cache_dir() -> Path:
     return path
 
 
+def cached_asset(key: bytes, suffix: str, write) -> Path:
+    """A content-addressed file in the asset cache, written atomically if missing."""
+    path = cache_dir() / (hashlib.sha1(key).hexdigest()[:20] + suffix)
+    if not path.exists():
+        tmp = path.with_name(f"{path.stem}.{os.getpid()}.tmp{suffix}")
+        write(tmp)
+        os.replace(tmp, path)
+    return path
+
+
 def connect() -> int:
     """A headless pybullet client (DIRECT: physics, ray casts and TinyRenderer images)."""
     return pb.connect(pb.DIRECT)
@@ -81,29 +87,20 @@ def disconnect(client: int) -> None:
 class World:
     """A house built in its own pybullet client (DIRECT: headless)."""
 
-    def __init__(self, house: House, settings: Resolved, renderer: str, physics_hz: float = 240.0) -> None:
-        """``renderer``: the resolved backend that will draw this world, ``gl`` or ``tiny``."""
-        if renderer not in ("gl", "tiny"):
-            raise ValueError(f"renderer must be a resolved backend, 'gl' or 'tiny', got {renderer!r}")
+    def __init__(self, house: House, settings: Resolved, physics_hz: float = 240.0) -> None:
         self.house = house
         self.state = WorldState(settings)
         self.physics_hz = physics_hz
-        self.renderer = renderer
-        self._pybullet_draws = self.renderer == "tiny"        # else pybullet bodies need no visual shape
         self.client = connect()
         self.visuals: dict[int, Visual] = {}     # pybullet body -> what it looks like
         pb.setGravity(0, 0, -9.81, physicsClientId=self.client)
         pb.setTimeStep(1.0 / physics_hz, physicsClientId=self.client)
-        self._assets = cache_dir()
-        self._textures: dict[str, int] = {}
         self._models_now: dict[str, int] = {}     # object -> model of its body, once load_model swapped it
         self._parked: dict[tuple[str, int], tuple] = {}      # (object, model) -> swapped-out body (load_model)
         self.instances: list[Instance] = []
         self._by_name: dict[str, Instance] = {}
         self.triangle_count = 0
-        self._looks: list[tuple[int, int, list[float]]] = []
         self._ray_groups: dict[int, int] = {}
-        self._building = True
         self.floor_z = float(np.median([r.floor_z for r in house.rooms]))
         self._build()
 
@@ -169,11 +166,8 @@ class World:
         # ground outside). Not a GEOM_PLANE, which crashes pybullet's EGL plugin.
         ground = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[GROUND_HALF_SIZE, GROUND_HALF_SIZE, 0.05],
                                          physicsClientId=self.client)
-        pb.createMultiBody(0, ground, -1, basePosition=[0, 0, self.floor_z - 0.051],
-                           physicsClientId=self.client)
-        # Every texture loads once, up front: run-time repaints then cost no file I/O.
-        for name in ("palette", "white", *paints.TEXTURES) if self._pybullet_draws else ():
-            self._texture(name)
+        self.ground = pb.createMultiBody(0, ground, -1, basePosition=[0, 0, self.floor_z - 0.051],
+                                         physicsClientId=self.client)
         self.instances = build_instances(self.house)
         self._by_name = {inst.name: inst for inst in self.instances}
         for inst in self.instances:
@@ -184,8 +178,6 @@ class World:
                 if inst.kind == "door":
                     self.place_door(inst.name, self.state.doors[inst.name])
         self._add_dressing()
-        self._building = False
-        self._flush_looks()
 
     def _structure_body(self, inst: Instance) -> int:
         room = self.house.room(inst.room)
@@ -227,18 +219,10 @@ class World:
         else:
             collision = self._parts_collision(placed)
         mesh = placed.mesh() if placed.model is None else None
-        drawn = mesh
-        if mesh is not None:
-            self.triangle_count += len(mesh.faces)
-        if placed.model is not None:
-            drawn = palette_stand_in(placed.model) if self._pybullet_draws else None
-            self.triangle_count += len(placed.model.faces)
-        if drawn is not None and self._pybullet_draws:
-            path = self._asset(mesh_bytes(drawn), ".obj", lambda p: write_palette_obj(drawn, p, PALETTE))
-            body = self._new_body(collision, placed.position, placed.yaw, path)
-            self._set_look(body, self._texture("palette"), [1, 1, 1, 1])
-        else:
-            body = self._new_body(collision, placed.position, placed.yaw)
+        shown = mesh if mesh is not None else placed.model
+        assert shown is not None, "a part has a model or a mesh"
+        self.triangle_count += len(shown.faces)
+        body = self._new_body(collision, placed.position, placed.yaw)
         self.visuals[body] = Visual(mesh=mesh, model=placed.model)
         return body
 
@@ -247,7 +231,7 @@ class World:
         which then sees what the camera draws), every one of them, glass included (glass is opaque
         to every sensor, :mod:`ravh_sim.world.library`), loaded from a cached OBJ file."""
         key = record(fitted).id.encode() + np.round(fitted.vertices, 5).tobytes()
-        path = self._asset(key, ".obj", lambda p: fitted.export(p, file_type="obj", include_normals=False,
+        path = cached_asset(key, ".obj", lambda p: fitted.export(p, file_type="obj", include_normals=False,
                                                               include_texture=False))
         return pb.createCollisionShape(pb.GEOM_MESH, fileName=str(path), flags=pb.GEOM_FORCE_CONCAVE_TRIMESH,
                                        physicsClientId=self.client)
@@ -255,33 +239,24 @@ class World:
     def _parts_collision(self, placed: Placed) -> int:
         """A compound of one convex hull per model part, loaded from a cached OBJ file."""
         text = hulls_obj_text(placed.parts)
-        path = self._asset(text.encode(), ".obj", lambda p: p.write_text(text))
+        path = cached_asset(text.encode(), ".obj", lambda p: p.write_text(text))
         return pb.createCollisionShape(pb.GEOM_MESH, fileName=str(path), physicsClientId=self.client)
 
     def _mesh_body(self, mesh: trimesh.Trimesh, collisions: list[int], surface: str) -> int:
         """A piece of structure drawn as ``mesh``, colliding as ``collisions`` (the base's shape, then
         one per fixed link; ``[-1]``: none)."""
-        path = None
-        if self._pybullet_draws:
-            key = np.concatenate([mesh.vertices.ravel(), mesh.visual.uv.ravel()]).round(4).tobytes()
-            path = self._asset(key, ".obj", lambda p: write_textured_obj(mesh, p))
         self.triangle_count += len(mesh.faces)
-        body = self._new_body(collisions[0], (0, 0, 0), 0.0, path, links=collisions[1:])
+        body = self._new_body(collisions[0], (0, 0, 0), 0.0, links=collisions[1:])
         self.visuals[body] = Visual(structure=mesh, surface=surface)
         return body
 
-    def _new_body(self, collision: int, position, yaw: float, visual_file: Path | None = None,
-                  links: list[int] | None = None) -> int:
-        """A static body; with a visual shape from ``visual_file`` only where pybullet draws (the
-        TinyRenderer): our GL renderer draws from :attr:`visuals`, and pybullet's parse of every
-        model's OBJ would only cost build time. ``links``: more collision shapes, each on a link
-        fixed to the base at its origin (rays and contacts report the body, so it stays one
-        instance)."""
-        visual = -1 if visual_file is None else pb.createVisualShape(pb.GEOM_MESH, fileName=str(visual_file),
-                                                                    physicsClientId=self.client)
+    def _new_body(self, collision: int, position, yaw: float, links: list[int] | None = None) -> int:
+        """A static body with no visual shape (renderers draw from :attr:`visuals`). ``links``: more
+        collision shapes, each on a link fixed to the base at its origin (rays and contacts report
+        the body, so it stays one instance)."""
         n = len(links or ())
         origin, identity = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]
-        return pb.createMultiBody(0, collision, visual, basePosition=list(position),
+        return pb.createMultiBody(0, collision, -1, basePosition=list(position),
                                   baseOrientation=quaternion_from_yaw(yaw), linkMasses=[0.0] * n,
                                   linkCollisionShapeIndices=list(links or ()), linkVisualShapeIndices=[-1] * n,
                                   linkPositions=[origin] * n, linkOrientations=[identity] * n,
@@ -290,52 +265,8 @@ class World:
                                   linkJointTypes=[pb.JOINT_FIXED] * n, linkJointAxis=[[0.0, 0.0, 1.0]] * n,
                                   physicsClientId=self.client)
 
-    def _asset(self, key: bytes, suffix: str, write) -> Path:
-        """A content-addressed file in the asset cache, written atomically if missing."""
-        path = self._assets / (hashlib.sha1(key).hexdigest()[:20] + suffix)
-        if not path.exists():
-            tmp = path.with_name(f"{path.stem}.{os.getpid()}.tmp{suffix}")
-            write(tmp)
-            os.replace(tmp, path)
-        return path
-
-    def _texture(self, name: str) -> int:
-        """pybullet texture id for 'palette', 'white' or a paint texture name (loaded once)."""
-        if name not in self._textures:
-            if name == "palette":
-                path = self._asset(PALETTE.image_rgb().tobytes(), ".png", PALETTE.write_texture)
-            elif name == "white":
-                path = self._asset(b"white", ".png", lambda p: cv2.imwrite(str(p), np.full((4, 4, 3), 255,
-                                                                                             np.uint8)))
-            else:
-                rgb = paints.texture_rgb(name)
-                path = self._asset(rgb.tobytes(), ".png",
-                                   lambda p: cv2.imwrite(str(p), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)))
-            self._textures[name] = pb.loadTexture(str(path), physicsClientId=self.client)
-        return self._textures[name]
-
     def _apply_paint(self, body: int, paint: str) -> None:
         self.visuals[body].paint = paint
-        if not self._pybullet_draws:
-            return
-        if paints.is_texture(paint):
-            texture, rgba = self._texture(paint), [1.0, 1.0, 1.0, 1.0]
-        else:
-            texture, rgba = self._texture("white"), [c / 255 for c in paints.plain_rgb(paint)] + [1]
-        self._set_look(body, texture, rgba)
-
-    def _set_look(self, body: int, texture: int, rgba: list[float]) -> None:
-        """Texture and colour of a body; queued while building (see :meth:`_flush_looks`)."""
-        self._looks.append((body, texture, rgba))
-        if not self._building:
-            self._flush_looks()
-
-    def _flush_looks(self) -> None:
-        """Apply queued looks. The EGL plugin drops visual changes made to bodies while later bodies
-        are still being created, so a build applies them all once every body exists."""
-        for body, texture, rgba in self._looks:
-            pb.changeVisualShape(body, -1, textureUniqueId=texture, rgbaColor=rgba, physicsClientId=self.client)
-        self._looks.clear()
 
     # ------------------------------------------------------------------ body primitives (for Appearance)
     def place_door(self, door_id: str, is_open: bool) -> None:
@@ -413,13 +344,7 @@ class World:
         assert placed.model is not None
         collision = self._model_collision(placed.model) if collides else -1
         self.triangle_count += len(placed.model.faces)
-        if self._pybullet_draws:
-            drawn = palette_stand_in(placed.model)
-            path = self._asset(mesh_bytes(drawn), ".obj", lambda p: write_palette_obj(drawn, p, PALETTE))
-            body = self._new_body(collision, placed.position, placed.yaw, path)
-            self._set_look(body, self._texture("palette"), [1, 1, 1, 1])
-        else:
-            body = self._new_body(collision, placed.position, placed.yaw)
+        body = self._new_body(collision, placed.position, placed.yaw)
         self.visuals[body] = Visual(model=placed.model)
         return body
 
@@ -456,8 +381,3 @@ def _quiet_stdout() -> Iterator[None]:
         os.close(saved)
         os.close(devnull)
 
-
-def mesh_bytes(mesh) -> bytes:
-    """A content key for a palette mesh."""
-    return (np.asarray(mesh.vertices).round(4).tobytes() + np.asarray(mesh.faces).tobytes()
-            + np.asarray(colours(mesh)).tobytes())
