@@ -22,23 +22,9 @@ from ravh_sim.world.house import load_house, resolve_house
 from ravh_sim.world.scene import World
 from ravh_sim.world.solids import model_count, object_parts
 
-CUBE_OBJ = """# a unit cube, material from Java 3D's defaults
-v 0 0 0
-v 1 0 0
-v 1 1 0
-v 0 1 0
-v 0 0 1
-v 1 0 1
-v 1 1 1
-v 0 1 1
-usemtl iris
-f 1 2 3 4
-f 5 8 7 6
-f 1 5 6 2
-f 2 6 7 3
-f 3 7 8 4
-f 4 8 5 1
-"""
+CUBE_VERTICES = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+CUBE_FACES = "f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n"
+CUBE_OBJ = "# a unit cube, material from Java 3D's defaults\n" + CUBE_VERTICES + "usemtl iris\n" + CUBE_FACES
 
 WALLS = [(0, 0, 800, 0), (800, 0, 800, 300), (800, 300, 0, 300), (0, 300, 0, 0), (400, 0, 400, 300)]
 
@@ -238,29 +224,9 @@ def test_own_model_file_stays_beside_the_house(imported, tmp_path):
         load_house(path)
 
 
-WINDOW_OBJ = """# a window: a white frame (a thin box) and a half see-through pane (Sweet Home 3D's flltgrey)
-v 0 0 0
-v 1 0 0
-v 1 1 0
-v 0 1 0
-v 0 0 1
-v 1 0 1
-v 1 1 1
-v 0 1 1
-v 0.1 0.5 0.1
-v 0.9 0.5 0.1
-v 0.9 0.5 0.9
-v 0.1 0.5 0.9
-usemtl white
-f 1 2 3 4
-f 5 8 7 6
-f 1 5 6 2
-f 2 6 7 3
-f 3 7 8 4
-f 4 8 5 1
-usemtl flltgrey
-f 9 10 11 12
-"""
+WINDOW_OBJ = ("# a window: a white frame (a box) and a half see-through pane (Sweet Home 3D's flltgrey)\n"
+              + CUBE_VERTICES + "v 0.1 0.5 0.1\nv 0.9 0.5 0.1\nv 0.9 0.5 0.9\nv 0.1 0.5 0.9\n"
+              + "usemtl white\n" + CUBE_FACES + "usemtl flltgrey\nf 9 10 11 12\n")
 
 
 def test_a_window_pane_is_clear_glass_whatever_its_colour(tmp_path):
