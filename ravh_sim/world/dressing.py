@@ -39,11 +39,11 @@ from dataclasses import dataclass
 
 import numpy as np
 import trimesh
-from shapely.geometry import Polygon
+from shapely.geometry import Point, Polygon
 
-from ravh_sim.world import library
+from ravh_sim.world import library, soft_furnishings
 from ravh_sim.world.house import House, HouseObject, Room
-from ravh_sim.world.solids import Placed, _fitted, object_parts
+from ravh_sim.world.solids import Placed, _fitted, _piece_bounds, object_parts
 from ravh_sim.world.structure import solid_walls
 
 LEVELS = ("none", "tidy", "lived-in")
@@ -79,7 +79,7 @@ TABLE = (_s("FruitBowl", "Dressing/fruit_bowl", (0.32, 0.32, 0.16), 1, 1),
          _s("Vase", "Dressing/vase Decoration/vase", (0.18, 0.18, 0.32), 1, 1),
          _s("Plate", "Dressing/plate", (0.26, 0.26, 0.04), 0, 4),
          _s("Cup", "Dressing/cup Cup", (0.12, 0.12, 0.11), 0, 3),
-         _s("Bowl", "Dressing/bowl", (0.17, 0.17, 0.08), 0, 2),
+         _s("Bowl", "Dressing/bowl", (0.17, 0.17, 0.08), 0, 1),
          _s("Book", "Dressing/book", (0.24, 0.17, 0.05), 0, 1))
 SMALL_TABLE = (_s("Vase", "Dressing/vase Decoration/vase", (0.16, 0.16, 0.28), 1, 1),
                _s("Book", "Dressing/book", (0.24, 0.17, 0.05), 0, 2),
@@ -92,7 +92,7 @@ DESK = (_s("Book", "Dressing/book", (0.24, 0.17, 0.05), 1, 3),
 WORKTOP = (_s("Kettle", "Dressing/kettle", (0.22, 0.2, 0.26), 1, 1),
            _s("DishRack", "Dressing/dish_rack", (0.45, 0.34, 0.16), 1, 1),
            _s("Pan", "Dressing/pan", (0.45, 0.28, 0.1), 0, 1),
-           _s("Bottle", "Dressing/bottle", (0.08, 0.08, 0.3), 0, 3),
+           _s("Bottle", "Dressing/bottle", (0.07, 0.07, 0.26), 0, 2),
            _s("Bowl", "Dressing/bowl", (0.17, 0.17, 0.08), 0, 1),
            _s("Cup", "Dressing/cup Cup", (0.12, 0.12, 0.11), 0, 2))
 SHELF = (_s("Book", "Dressing/book", (0.17, 0.24, 0.25), 2, 6, facing="support"),
@@ -101,12 +101,12 @@ SHELF = (_s("Book", "Dressing/book", (0.17, 0.24, 0.25), 2, 6, facing="support")
          _s("Vase", "Dressing/vase Decoration/vase", (0.14, 0.14, 0.24), 0, 1))
 BED = (_s("Duvet", "Dressing/duvet", (1.4, 1.6, 0.12), 1, 1, stretch=True, flat=0.08, touching=0.3,
           facing="support"),
-       _s("Pillow", "Dressing/pillow", (0.45, 0.7, 0.16), 1, 2, flat=0.05, touching=0.4, facing="support"))
+       _s("Pillow", "Dressing/pillow", (0.45, 0.7, 0.14), 1, 2, flat=0.05, touching=0.4, facing="support"))
 SOFA = (_s("Cushion", "Dressing/cushion", (0.2, 0.45, 0.45), 1, 3, flat=0.04, touching=0.4, facing="support"),
-        _s("Throw", "Dressing/throw", (0.6, 1.0, 0.08), 0, 1, stretch=True, flat=0.05, touching=0.4,
+        _s("Throw", "Dressing/throw", (0.6, 1.0, 0.07), 0, 1, stretch=True, flat=0.05, touching=0.4,
            facing="support"))
 RUG = _s("Rug", "Dressing/rug", (1.6, 2.2, 0.02), 1, 1, stretch=True, collides=False, facing="support")
-CURTAIN = _s("Curtain", "Dressing/curtain", (0.12, 0.6, 2.4), 0, 2, stretch=True, facing="out")
+CURTAIN = _s("Curtain", "Dressing/curtain", (0.2, 1.6, 2.4), 0, 1, stretch=True, facing="out")   # a pair, drawn open
 BLIND = _s("Blind", "Dressing/blind", (0.06, 1.2, 0.6), 0, 1, stretch=True, facing="out")
 FLOOR_PLANT = _s("Plant", "Dressing/floor_plant Decoration", (0.6, 0.6, 1.1), 0, 1)
 WALL_ART = _s("Picture", "Dressing/wall_art", (0.04, 0.8, 0.6), 0, 1, stretch=True, facing="out")
@@ -158,14 +158,19 @@ class Dressed:
 
     def placed(self) -> Placed:
         """The fitted model in its body frame and the body's pose, as :mod:`ravh_sim.world.solids` has it."""
-        fitted, bounds = _fitted(self.slot.model_id, self.slot.size, 0)
+        if soft_furnishings.is_soft(self.slot.model_id):
+            fitted = soft_furnishings.model(self.slot.model_id, self.slot.size)
+            bounds = _piece_bounds(fitted.vertices, fitted.faces, fitted.face_attributes["piece"])
+        else:
+            fitted, bounds = _fitted(self.slot.model_id, self.slot.size, 0)
         return Placed((), bounds, self.position, self.yaw, fitted, self.yaw)
 
 
 def kind_models(spec: Spec) -> tuple[library.LibraryRecord, ...]:
-    """The library models of the first of the spec's kinds that has any (empty: none yet)."""
+    """The library models of the first of the spec's kinds that has any, or else the soft models
+    made here (:mod:`ravh_sim.world.soft_furnishings`: pillows, duvets, cushions, throws); empty: none."""
     for kind in spec.kinds:
-        found = library.models_of(kind)
+        found = library.models_of(kind) or soft_furnishings.records(kind)
         if found:
             return found
     return ()
@@ -205,7 +210,11 @@ def slots(house: House, seed: int) -> tuple[Slot, ...]:
             plan.append((obj.room, obj.id, RUG, 0))
     for window in house.windows:
         wide = window.width > 1.3
-        spec = CURTAIN if wide or random.Random(f"{seed}/dressing/{window.id}").random() < 0.6 else BLIND
+        wet = house.room(window.room).type in ("Bathroom", "Kitchen")
+        draw = random.Random(f"{seed}/dressing/{window.id}").random()
+        spec = CURTAIN if not wet and (wide or draw < 0.7) or wet and wide and draw < 0.3 else BLIND
+        if spec is CURTAIN and _blocked_below(house, window):
+            spec = BLIND                           # furniture under the window: a blind, not long curtains
         plan += [(window.room, window.id, spec, k) for k in range(spec.lived_in)]
     for room in house.rooms:
         if room.type in CORNER_ROOMS:
@@ -233,6 +242,25 @@ def slots(house: House, seed: int) -> tuple[Slot, ...]:
         out.append(Slot(name, spec.type, first_instance + len(out), room_id, support, spec, record.id,
                         _size(record.id, spec, _box(house, support, spec)), tidy, k))
     return tuple(out)
+
+
+def _blocked_below(house: House, window) -> bool:
+    """Whether an object of the house (its box, whatever its model) stands in front of the window
+    below its sill, where floor-length curtains would hang."""
+    n = np.array([math.cos(window.yaw + math.pi / 2), math.sin(window.yaw + math.pi / 2)])
+    centre = np.asarray(window.position[:2], np.float64)
+    if not house.room(window.room).contains(*(centre + 0.3 * n)):
+        n = -n
+    front = _rect(tuple(centre + n * 0.25), (0.4, window.width + 0.5), math.atan2(n[1], n[0]))
+    sill = window.position[2] - window.height / 2
+    for obj in house.objects:
+        if obj.type in ("Wall", "Window", "Door", "Picture", "Mirror", "Light") or obj.room != window.room:
+            continue
+        if obj.position[2] - obj.size[2] / 2 > sill:
+            continue
+        if _rect(obj.position[:2], obj.size[:2], obj.yaw).intersects(front):
+            return True
+    return False
 
 
 MAX_SCALE = 2.0
@@ -279,8 +307,8 @@ def _box(house: House, support: str, spec: Spec) -> tuple[float, float, float]:
         window = next(wd for wd in house.windows if wd.id == support)
         room = house.room(window.room)
         top = min(window.position[2] + window.height / 2 + 0.12, room.ceiling_z - 0.05)
-        if spec.type == "Curtain":
-            return (spec.box[0], spec.box[1], top - room.floor_z - 0.03)
+        if spec.type == "Curtain":             # the pair's panels hang beside the window, over its edges
+            return (spec.box[0], window.width + 0.5, top - room.floor_z - 0.03)
         return (spec.box[0], window.width + 0.06, min(0.6, 0.45 * window.height))
     return spec.box
 
@@ -288,6 +316,8 @@ def _box(house: House, support: str, spec: Spec) -> tuple[float, float, float]:
 def _size(model_id: str, spec: Spec, box_size: tuple[float, float, float]) -> tuple[float, float, float]:
     """The model's box when scaled into ``box_size``: uniformly (keeping its proportions), or as the
     library fits furniture where the spec stretches (a duvet to a bed, a curtain to a window)."""
+    if soft_furnishings.is_soft(model_id):          # made to measure
+        return tuple(round(float(v), 4) for v in box_size)      # type: ignore[return-value]
     natural = np.maximum(np.ptp(library.load_model(model_id).vertices, axis=0), 1e-4)
     box = np.asarray(box_size, np.float64)
     scale = library.fit_scale(natural, box) if spec.stretch else np.full(3, (box / natural).min())
@@ -481,12 +511,18 @@ def _on_support(scene: _Scene, slot: Slot, obj: HouseObject, rng: random.Random
         zs = crossings(triangles, np.array([_body_to_house(p, (lo + hi)[:2] / 2)]))[0]
         levels = sorted({round(float(z), 4) for z in zs[np.isfinite(zs)]}, reverse=True)
         rng.shuffle(levels)
+    dining = obj.type == "Table" and _support_kind(obj) == "Table"
+    places = _places(scene, obj, p, lo, hi, reach, rng) if dining and slot.type == "Plate" else []
     for attempt in range(CANDIDATES):
         # a point of the support's top, in its body frame, away from its edges by the object's reach
         span = np.maximum((hi[:2] - lo[:2]) / 2 - reach, 0.0)
+        if dining and slot.type in ("FruitBowl", "Vase"):       # the middle of a dining table
+            span = span * 0.3
         u, v = (rng.uniform(-1, 1) * span + (lo[:2] + hi[:2]) / 2)
+        if places and attempt < 2 * len(places):                 # a plate at a place, before a chair
+            u, v = places[(slot.order + attempt) % len(places)]
         if obj.type == "Bed" or obj.type == "Sofa":
-            u, v = _soft_spot(slot, p, lo, hi, rng)
+            u, v = _soft_spot(slot, p, lo, hi, rng, attempt)
         x, y = p.position[0] + c * u - s * v, p.position[1] + s * u + c * v
         yaw = front if slot.spec.facing == "support" else rng.uniform(-math.pi, math.pi)
         if obj.type == "Shelf" and slot.spec.facing == "support":
@@ -501,27 +537,62 @@ def _on_support(scene: _Scene, slot: Slot, obj: HouseObject, rng: random.Random
     return None
 
 
-def _soft_spot(slot: Slot, p: Placed, lo: np.ndarray, hi: np.ndarray, rng: random.Random) -> tuple[float, float]:
+def _places(scene: _Scene, obj: HouseObject, p: Placed, lo: np.ndarray, hi: np.ndarray, reach: float,
+            rng: random.Random) -> list[tuple[float, float]]:
+    """A dining table's places (body frame): the points of its top nearest each chair at it, a plate's
+    reach in from the edge; without chairs, two a side along its long sides."""
+    inset = reach + 0.04
+    a, b = lo[:2] + inset, hi[:2] - inset
+    if np.any(a > b):
+        return []
+    c, s = math.cos(p.yaw), math.sin(p.yaw)
+    out = []
+    for other in scene.house.objects:
+        if other.type != "Chair" or other.room != obj.room:
+            continue
+        dx, dy = other.position[0] - p.position[0], other.position[1] - p.position[1]
+        u, v = c * dx + s * dy, -s * dx + c * dy
+        if lo[0] - 0.9 < u < hi[0] + 0.9 and lo[1] - 0.9 < v < hi[1] + 0.9:
+            out.append((float(np.clip(u, a[0], b[0])), float(np.clip(v, a[1], b[1]))))
+    if not out:
+        long = 0 if hi[0] - lo[0] >= hi[1] - lo[1] else 1
+        mid = (a + b) / 2
+        for along in (-0.3, 0.3):
+            for side in (a[1 - long], b[1 - long]):
+                q = [0.0, 0.0]
+                q[long] = float(np.clip(mid[long] + along, a[long], b[long]))
+                q[1 - long] = float(side)
+                out.append((q[0], q[1]))
+    rng.shuffle(out)
+    return out
+
+
+def _soft_spot(slot: Slot, p: Placed, lo: np.ndarray, hi: np.ndarray, rng: random.Random, attempt: int = 0
+               ) -> tuple[float, float]:
     """Where on a bed or a sofa (body frame): pillows at the head, the duvet over the foot, cushions
-    along the back, a throw on the seat. The body's +x is its front (a bed's foot, a sofa's seat edge)
-    turned by the model's facing, so go by the front heading."""
+    along the back, a throw on the seat by an arm. The body's +x is its front (a bed's foot, a sofa's
+    seat edge) turned by the model's facing, so go by the front heading. Later attempts move away from
+    the head or the back, where the first found the model's own headboard or back in the way."""
     f = (p.front if p.front is not None else p.yaw) - p.yaw
     fx, fy = math.cos(f), math.sin(f)
     depth = abs(fx) * (hi[0] - lo[0]) + abs(fy) * (hi[1] - lo[1])
     width = abs(fy) * (hi[0] - lo[0]) + abs(fx) * (hi[1] - lo[1])
     mid = (lo[:2] + hi[:2]) / 2
     d, w, _ = slot.size
+    step = 0.025 * attempt
     if slot.type == "Pillow":
-        along, across = -depth / 2 + d / 2 + 0.08 + rng.uniform(0, 0.05), 0.0
+        along, across = -depth / 2 + d / 2 + 0.03 + step + rng.uniform(0, 0.02), 0.0
         if slot.spec.lived_in > 1 and width > 1.2:
-            across = (-1) ** slot.order * width / 4
+            across = (-1) ** slot.order * (width / 4 - 0.02) + rng.uniform(-0.02, 0.02)
     elif slot.type == "Duvet":
-        along, across = depth / 2 - d / 2 - rng.uniform(0.02, 0.1), 0.0
+        along, across = depth / 2 - d / 2 - rng.uniform(0.0, 0.06) - step, 0.0
     elif slot.type == "Cushion":
-        along = -depth / 2 + d / 2 + rng.uniform(0.15, 0.3)
-        across = (slot.order - 1) * min(w * 1.1, width / 3.2) + rng.uniform(-0.05, 0.05)
-    else:
-        along, across = rng.uniform(-0.1, 0.1), rng.uniform(-0.3, 0.3) * max(width - w, 0.0)
+        along = -depth / 2 + d / 2 + 0.06 + step + rng.uniform(0, 0.03)
+        across = (slot.order - 1) * min(w * 1.15, width / 3.2) + rng.uniform(-0.04, 0.04)
+    else:                          # by either arm, on the seat's front half
+        side = 1 if (attempt + slot.order) % 2 == 0 else -1
+        along = rng.uniform(0.0, max(depth / 2 - d / 2 - 0.02, 0.0))
+        across = side * max(width / 2 - w / 2 - 0.1 - 0.02 * (attempt // 2), 0.0)
     return mid[0] + fx * along - fy * across, mid[1] + fy * along + fx * across
 
 
@@ -547,14 +618,24 @@ def _rug(scene: _Scene, slot: Slot, obj: HouseObject, rng: random.Random
     f = front - p.yaw
     depth = abs(math.cos(f)) * (hi[0] - lo[0]) + abs(math.sin(f)) * (hi[1] - lo[1])
     centre = np.array(_body_to_house(p, (lo + hi)[:2] / 2))
+    width = abs(math.sin(f)) * (hi[0] - lo[0]) + abs(math.cos(f)) * (hi[1] - lo[1])
     ahead = np.array([math.cos(front), math.sin(front)])
-    for overlap in (0.3, 0.15, 0.0, -0.15):
-        x, y = centre + ahead * (depth / 2 + d / 2 - overlap) + rng.uniform(-0.03, 0.03)
-        if not _floor_ok(scene, slot, x, y, room) or not all(
-                room.contains(*q) for q in footprint_points((x, y), (d, w), front, 3)):
+    beside = np.array([-ahead[1], ahead[0]])
+    candidates = [(centre + ahead * (depth / 2 + d / 2 - overlap) + beside * shift, front)
+                  for overlap in (0.3, 0.15, 0.0, -0.15) for shift in (0.0, 0.25, -0.25, 0.5, -0.5)]
+    if obj.type == "Bed":              # or along either side of a bed, turned across it
+        candidates += [(centre + beside * side * (width / 2 + d / 2 - overlap), front + math.pi / 2)
+                       for overlap in (0.2, 0.0) for side in (1, -1)]
+    for (x, y), yaw in candidates:
+        x, y = x + rng.uniform(-0.02, 0.02), y + rng.uniform(-0.02, 0.02)
+        outline = _rect((x, y), (d, w), yaw)
+        if not all(room.contains(*q) for q in footprint_points((x, y), (d, w), yaw, 4)):
             continue
-        if scene.clear(_rect((x, y), (d, w), front), room.floor_z + 0.001, room.floor_z + h):
-            return (float(x), float(y), room.floor_z + h / 2), front
+        # the robot drives over a rug: it only keeps a doorway's and the station's own spot free
+        if any(outline.distance(Point(*q)) < 0.45 for q in scene.keep_free):
+            continue
+        if scene.clear(outline, room.floor_z + 0.001, room.floor_z + h):
+            return (float(x), float(y), room.floor_z + h / 2), yaw
     return None
 
 
@@ -655,28 +736,49 @@ def _at_window(scene: _Scene, slot: Slot, obj: HouseObject, rng: random.Random
                 (xy for poly in (ob.outline for ob in scene.obstacles[obj.id]) for xy in poly.exterior.coords))
     surface = min((_to_segment(centre, wl.a, wl.b), wl.thickness / 2) for wl in scene.house.walls
                   if wl.room == window.room)[1]          # the wall's room face, from the window's centre
+    surface = _wall_face(scene, centre, n, along, window.width + 0.2, surface)
     wall = max(reach, surface)
     d, w, h = slot.size
     top = min(window.position[2] + window.height / 2 + 0.12, room.ceiling_z - 0.05)
     yaw = math.atan2(n[1], n[0])
     if slot.type == "Curtain":
-        side = 1 if slot.order == 0 else -1
-        for gap in (0.005, 0.1):                          # beside the frame, on the wall
-            offset = window.width / 2 + w / 2 + gap
-            x, y = centre + n * (surface + d / 2 + 0.001) + along * side * offset
-            z = top - h / 2
-            if not room.contains(x, y):
-                continue
-            if not _wall_behind(scene, (x, y), n, d, w, z - h / 2, z + h / 2):
-                continue
-            if scene.clear(_rect((x, y), (d, w), yaw), z - h / 2, z + h / 2):
-                return (float(x), float(y), z), yaw
+        # the pair centred on the window, in front of its frame; solid wall behind both panels' outer parts
+        x, y = centre + n * (wall + d / 2 + 0.002)
+        z = top - h / 2
+        ext = min((w - window.width) / 2, 0.2)
+        for side in (1, -1):
+            px, py = centre + n * (surface + d / 2 + 0.001) + along * side * (w / 2 - ext / 2)
+            if not room.contains(px, py) or not _wall_behind(scene, (px, py), n, d, ext, z - h / 2, z + h / 2):
+                return None
+        if scene.clear(_rect((x, y), (d, w), yaw), z - h / 2, z + h / 2):
+            return (float(x), float(y), z), yaw
         return None
     x, y = centre + n * (wall + d / 2 + 0.002)
     z = top - h / 2
     if scene.clear(_rect((x, y), (d, w), yaw), z - h / 2, z + h / 2):
         return (float(x), float(y), z), yaw
     return None
+
+
+def _wall_face(scene: _Scene, centre: np.ndarray, n: np.ndarray, along: np.ndarray, width: float,
+               fallback: float) -> float:
+    """How far from a window's centre its wall's room face stands (along ``n``), as the walls' solids
+    have it beside the window (the house's wall lines may stand off its centre)."""
+    yaw = math.atan2(n[1], n[0])
+    found = []
+    for side in (1, -1):           # thin probes across the wall just beside the window
+        probe = _rect(tuple(centre + n * 0.05 + along * side * (width / 2)), (0.7, 0.01), yaw)
+        for o in scene.walls:
+            if not o.outline.intersects(probe):
+                continue
+            part = o.outline.intersection(probe)
+            for poly in getattr(part, "geoms", [part]):
+                if poly.area < 1e-7:
+                    continue
+                t = [float(np.dot(np.asarray(q) - centre, n)) for q in poly.exterior.coords]
+                if min(t) <= 0.02 and max(t) < 0.35:          # the wall the window is in, not one across
+                    found.append(max(t))
+    return max(found) if found else fallback
 
 
 def _to_segment(p: np.ndarray, a: Sequence[float], b: Sequence[float]) -> float:
