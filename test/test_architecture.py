@@ -182,10 +182,11 @@ def test_the_layer_check_finds_an_arrow_pointing_up():
 # --------------------------------------------------------------------------- who talks to pybullet
 
 # The World owns the client (bodies of the house, ray casts); a robot builds and drives its own body
-# on it, the Simulation steps it, and the TinyRenderer draws through it. Nothing else calls pybullet:
+# on it, the Simulation steps it, and the TinyRenderer draws through it (its visual mirror of the
+# world's bodies, tiny_scene, lives in the same client). Nothing else calls pybullet:
 # sensors ask the World or a renderer (ravh_sim.render), so a physics or renderer change stays there.
 PYBULLET_OWNERS = {"ravh_sim.world.scene", "ravh_sim.robot.robot", "ravh_sim.robot.simulation",
-                   "ravh_sim.render.tiny_renderer"}
+                   "ravh_sim.render.tiny_renderer", "ravh_sim.render.tiny_scene"}
 
 
 def _imports_pybullet(path: Path) -> bool:

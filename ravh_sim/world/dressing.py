@@ -43,6 +43,7 @@ from shapely.geometry import Point, Polygon
 
 from ravh_sim.world import library, soft_furnishings
 from ravh_sim.world.house import House, HouseObject, Room
+from ravh_sim.world.instances import build_instances
 from ravh_sim.world.solids import Placed, _fitted, _piece_bounds, object_parts
 from ravh_sim.world.structure import solid_walls
 
@@ -286,7 +287,6 @@ def _suitable(records: tuple[library.LibraryRecord, ...], spec: Spec, box_size: 
 
 
 def _instance_count(house: House) -> int:
-    from ravh_sim.world.footprint import build_instances
     return len(build_instances(house))
 
 

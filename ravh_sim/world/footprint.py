@@ -1,77 +1,34 @@
-"""Instances and the footprint: what is in the world, with ids and mask colours, so a run can be reproduced.
+"""The footprint: what is in the world, with ids, mask colours, poses and models, so a run can be reproduced.
 
-The instance table is a pure function of the house and the resolved settings (no pybullet): one entry
-per room surface (floor, ceiling, walls) and per labelled object, in a fixed order, numbered from 1
-(0 means "nothing" in instance images), then the dressing objects the seed may place
-(:func:`dressing_instances`, ``kind: dressing``). The footprint is that table with each instance's pose and
-model (dressing rows only for those the settings' ``dressing`` level places, marked ``dressing: true``
-with their ``support``), plus the resolved settings; :func:`load_footprint` gives back the house number and settings,
-from which the World rebuilds exactly the same scene.
+The instance table (:mod:`ravh_sim.world.instances`: every room surface and labelled object) is followed
+by the dressing objects the seed may place (:func:`dressing_instances`, ``kind: dressing``). The
+footprint is that table with each instance's pose and model (dressing rows only for those the settings'
+``dressing`` level places, marked ``dressing: true`` with their ``support``), plus the resolved settings;
+:func:`load_footprint` gives back the house number and settings, from which the World rebuilds exactly
+the same scene.
 """
 from __future__ import annotations
 
 import json
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ravh_sim.errors import FileFieldError
 from ravh_sim.files import atomic_write
 from ravh_sim.poses import quaternion_from_yaw
+from ravh_sim.world.dressing import slots
 from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import House
+from ravh_sim.world.instances import STRUCTURE_KINDS, Instance, build_instances, mask_color
 from ravh_sim.world.library import record
 from ravh_sim.world.settings import Resolved
 from ravh_sim.world.solids import object_parts
 
 FOOTPRINT_FORMAT = "ravh_sim/footprint@1"
-STRUCTURE_KINDS = ("floor", "ceiling", "walls")
-
-
-@dataclass
-class Instance:
-    """Something the camera can see, with the id that instance images store."""
-    id: int                        # >= 1
-    name: str                      # object id, or '<room id>/floor|ceiling|walls'
-    kind: str                      # object | door | window | floor | ceiling | walls | dressing
-    room: str
-    room_type: str
-    type: str                      # object category (first tag) or the structure kind
-    tags: tuple[str, ...]
-    mask_color: tuple[int, int, int]
-    body: int = -1                 # pybullet body, set by the World
-
-
-def mask_color(instance_id: int) -> tuple[int, int, int]:
-    """A unique colour per id: the id's bits spread over R, G, B from the top bit down, so that
-    consecutive ids get very different colours (and the mapping is invertible)."""
-    rgb = [0, 0, 0]
-    for bit in range(24):
-        if instance_id >> bit & 1:
-            rgb[bit % 3] |= 1 << (7 - bit // 3)
-    return (rgb[0], rgb[1], rgb[2])
-
-
-def build_instances(house: House) -> list[Instance]:
-    """Every instance of ``house`` in its fixed order."""
-    specs: list[tuple[str, str, str, str, tuple[str, ...]]] = []
-    rooms_with_walls = {w.room for w in house.walls}
-    for room in house.rooms:
-        for kind in STRUCTURE_KINDS:
-            if kind != "walls" or room.id in rooms_with_walls:
-                specs.append((f"{room.id}/{kind}", kind, room.id, kind, (kind,)))
-    for obj in house.objects:
-        kind = "door" if obj.id in house.door_by_id else "window" if obj.type == "Wall" else "object"
-        specs.append((obj.id, kind, obj.room, obj.type, obj.tags))
-    return [Instance(i, name, kind, room, house.room(room).type, type_, tags, mask_color(i))
-            for i, (name, kind, room, type_, tags) in enumerate(specs, start=1)]
-
-
 def dressing_instances(house: House, seed: int) -> list[Instance]:
     """Every dressing object that ``seed`` may place in ``house`` (:func:`ravh_sim.world.dressing.slots`),
     numbered after the house's instances: the same ids at every level and with every object model."""
-    from ravh_sim.world.dressing import slots
     return [Instance(s.instance, s.id, "dressing", s.room, house.room(s.room).type, s.type, s.tags,
                      mask_color(s.instance)) for s in slots(house, seed)]
 
