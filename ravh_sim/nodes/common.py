@@ -23,7 +23,10 @@ SIM_LOST_S = 8.0        # wall seconds without /clock after which a sim counts a
 STOP_LATENCY_S = 0.1    # longest a spinning node takes to notice SIGINT/SIGTERM
 DRAIN_S = 10.0          # longest a stopping node spends finishing the requests it took
 
-SENSOR_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=5, reliability=ReliabilityPolicy.RELIABLE,
+# Sensor topics carry captures too: a burst of captures (requests that reach the sim together) must fit
+# the history at both ends while a loaded recorder catches up, or a reliable writer drops the oldest
+# (seen once under load: a burst of 7 lost its last two captures' images with a depth of 5).
+SENSOR_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=12, reliability=ReliabilityPolicy.RELIABLE,
                         durability=DurabilityPolicy.VOLATILE)
 STATE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE,
                        durability=DurabilityPolicy.VOLATILE)
