@@ -16,6 +16,7 @@ import pytest
 from conftest import ROOT, subprocess_env
 
 from ravh_msgs_py.appearance import parse
+from ravh_sim.world.dressing import dressing
 from ravh_sim.world.scene import OPEN_DOOR_DROP
 from ravh_sim.world.solids import model_count
 
@@ -118,8 +119,11 @@ def test_a_swapped_out_model_is_parked_out_of_the_house_and_comes_back(world, ap
     # be next in its way if it had stayed: it hits neither, and a ray through the parking spot hits it
     (x, y, z), _ = pose
     down = ([[x, y, z + 3.0]], [[x, y, world.floor_z - 1.0]])
-    assert world.cast_rays(*down)[0][0] == swapped
-    assert world.cast_rays(*down, mask=world.ray_mask([swapped]))[0][0] not in (body, swapped)
+    on_bed = {d.id for d in dressing(world.house, world.state.models, world.state.dressing, world.state.seed)
+              if d.slot.support == "Bed_0"}                         # pillows and a duvet lie on the bed
+    dressing_bodies = [world.instance(name).body for name in on_bed]
+    assert world.cast_rays(*down, mask=world.ray_mask(dressing_bodies))[0][0] == swapped
+    assert world.cast_rays(*down, mask=world.ray_mask([swapped, *dressing_bodies]))[0][0] not in (body, swapped)
     parked = z - OPEN_DOOR_DROP
     assert world.cast_rays([[x, y, parked + 3.0]], [[x, y, parked - 3.0]])[0][0] == body
     assert pb.getBasePositionAndOrientation(body, physicsClientId=c)[0] == pytest.approx((x, y, parked))
