@@ -7,6 +7,7 @@ and exit status 2, never a traceback.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import os
 import signal
@@ -24,7 +25,7 @@ from ravh_sim.nodes.launch import NODES
 from ravh_sim.nodes.launch import main as launch_node
 from ravh_sim.paths import FURNITURE_DIR, HOUSES_DIR
 from ravh_sim.raids.build import add_parser as add_dataset_parser
-from ravh_sim.render.backend import BACKENDS
+from ravh_sim.render.backend import BACKENDS, QUALITIES
 
 Command = Callable[[argparse.Namespace], int]
 
@@ -217,7 +218,10 @@ def cmd_render(args: argparse.Namespace) -> int:
             appearance.set_knob("sun_angle", _sun_value(args.sun))
         if args.lights is not None:
             appearance.set_lights("all", args.lights, args.seed)
-        camera = SmartCamera(world, load_profile(args.profile).camera, backend=args.renderer)
+        spec = load_profile(args.profile).camera
+        if args.quality is not None:
+            spec = dataclasses.replace(spec, quality=args.quality)
+        camera = SmartCamera(world, spec, backend=args.renderer)
         paths = write_capture(camera, camera.capture(*pose), args.output)
     print("wrote " + ", ".join(str(p) for p in paths))
     return 0
@@ -363,6 +367,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--renderer", choices=BACKENDS, default="auto")
     p.add_argument("--profile", default=DEFAULT_PROFILE,
                    help=f"robot profile for the camera (default: {DEFAULT_PROFILE})")
+    p.add_argument("--quality", choices=QUALITIES, default=None,
+                   help="camera quality (default: the profile's); dataset: realistic shading of the furniture "
+                        "library's finer models and textures")
     p.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     p.set_defaults(func=cmd_render)
 

@@ -181,7 +181,7 @@ def test_types_with_upstream_variants_have_three_library_models(houses):
 
 def test_attribution_covers_every_shipped_model_with_an_open_licence():
     catalog = library.catalog()
-    files = {p.name for p in (FURNITURE_DIR / "models").iterdir()}
+    files = {p.name for p in (FURNITURE_DIR / "models").iterdir() if not p.name.endswith(library.FULL_SUFFIX)}
     assert files == {f"{r.id}.npz" for r in catalog.models} and len(files) >= 100
     attribution = (FURNITURE_DIR / "ATTRIBUTION.md").read_text()
     for record in catalog.models:
@@ -195,8 +195,9 @@ def test_asset_set_stays_compact():
     """The library as shipped: 2.4 MB on disk (1.7 MB before the dressing objects and detailed
     appliances), and every model within what the importer lets through (its kind's budget by size,
     x OVER_BUDGET, or ABSOLUTE_BUDGET), but for the kinds named in OVER_BUDGET."""
-    size = sum(p.stat().st_size for p in FURNITURE_DIR.rglob("*") if p.is_file())
-    assert size < 2.6e6
+    live = [p for p in FURNITURE_DIR.rglob("*") if p.is_file() and not p.name.endswith(library.FULL_SUFFIX)
+            and p.parent.name != "full"]
+    assert sum(p.stat().st_size for p in live) < 2.6e6
     catalog = library.catalog().models
     over = {}
     for record in catalog:
@@ -314,3 +315,70 @@ def test_placed_library_models_lie_in_their_box_and_cover_their_pieces(houses):
             assert hi == pytest.approx(placed.model.vertices.max(axis=0), abs=1e-9)
             checked += 1
     assert checked > 100
+
+
+# --- the dataset level of detail -------------------------------------------------------------------
+
+def test_importer_writes_a_dataset_level_only_where_the_rule_asks_and_it_is_finer(tmp_path, monkeypatch):
+    import ravh_sim.importers.furniture as importer
+    monkeypatch.setattr(importer, "TRIANGLE_BUDGET", 40)
+    monkeypatch.setattr(importer, "MIN_TRIANGLES", 40)
+    sphere = trimesh.creation.icosphere(3)                              # 1280 triangles
+    obj = "\n".join([f"v {x} {y} {z}" for x, y, z in sphere.vertices * 50]
+                    + ["f " + " ".join(str(i + 1) for i in f) for f in sphere.faces]) + "\n"
+    archive = tmp_path / "Ball.sh3f"
+    with zipfile.ZipFile(archive, "w") as zf:
+        zf.writestr("PluginFurnitureCatalog.properties", "id#1=T#ball\nname#1=Ball\ncategory#1=Bedroom\n"
+                    "model#1=/ball.obj\nwidth#1=50\ndepth#1=50\nheight#1=50\ncreator#1=X\nlicense#1=CC0\n")
+        zf.writestr("ball.obj", obj)
+    out = tmp_path / "out"
+    import_furniture([archive], out, {"Ball": Rule(r"ball", ("Bedroom",), dataset=True),
+                                      "Orb": Rule(r"ball", ("Bedroom",))}, progress=False)
+    (ball, orb) = LibraryCatalog.model_validate_json((out / "catalog.json").read_text()).models
+    assert not (out / "models" / f"{orb.id}{library.FULL_SUFFIX}").exists()       # not asked for
+    with np.load(out / "models" / f"{ball.id}{library.FULL_SUFFIX}") as data:
+        full = data["faces"]
+        assert np.ptp(data["vertices"], axis=0) == pytest.approx((0.5, 0.5, 0.5), abs=0.02)
+        assert set(data["face_material"].tolist()) == {0}
+    assert importer.DATASET_FACTOR * ball.triangles * 0.8 <= len(full) <= importer.DATASET_FACTOR * 40 * 1.05
+    # a second import reproduces both levels byte for byte
+    again = tmp_path / "again"
+    import_furniture([archive], again, {"Ball": Rule(r"ball", ("Bedroom",), dataset=True),
+                                        "Orb": Rule(r"ball", ("Bedroom",))}, progress=False)
+    for path in out.rglob("*"):
+        if path.is_file():
+            assert path.read_bytes() == (again / path.relative_to(out)).read_bytes(), path
+
+
+def test_dataset_level_is_finer_and_stands_where_the_live_model_does():
+    """Every dataset-level model: at least DATASET_MIN_GAIN times the live triangles, the same materials,
+    and once fitted (fit and a turn, as the World does) mapped into the same box as the live model; the
+    committed dataset level stays within a few MB."""
+    from ravh_sim.importers.furniture import DATASET_MAX_TRIANGLES, DATASET_MIN_GAIN
+    full_files = list((FURNITURE_DIR / "models").glob(f"*{library.FULL_SUFFIX}"))
+    assert full_files and sum(p.stat().st_size for p in full_files) < 5e6
+    assert sum(p.stat().st_size for p in (FURNITURE_DIR / "textures" / "full").iterdir()) < 5e6
+    turn = trimesh.transformations.rotation_matrix(np.pi / 2, (0, 0, 1))[:3, :3]
+    for path in full_files:
+        model_id = path.name[:-len(library.FULL_SUFFIX)]
+        live, full = library.load_model(model_id), library.load_model(model_id, "dataset")
+        assert DATASET_MIN_GAIN * len(live.faces) <= len(full.faces) <= OVER_BUDGET * DATASET_MAX_TRIANGLES, model_id
+        assert library.face_material(full).max() < len(library.record(live).materials)
+        size = np.array([0.6, 0.5, 0.85])
+        fitted = library.with_vertices(live, library.fit(live, size) @ turn.T)
+        drawn = library.dataset_model(fitted)
+        assert len(drawn.faces) == len(full.faces)
+        lo, hi = fitted.vertices.min(axis=0), fitted.vertices.max(axis=0)
+        # the same box, but where the live level's simplification cut a protruding part (a fridge's handle)
+        assert np.all(drawn.vertices.min(axis=0) > lo - 0.03) and np.all(drawn.vertices.max(axis=0) < hi + 0.03)
+    plain = library.load_model(library.catalog().models[0].id)
+    assert library.dataset_model(plain) is plain or library.has_dataset_level(library.record(plain).id)
+
+
+def test_dataset_textures_are_the_live_ones_larger():
+    for path in (FURNITURE_DIR / "textures" / "full").iterdir():
+        live, full = cv2.imread(str(FURNITURE_DIR / "textures" / path.name)), cv2.imread(str(path))
+        assert live is not None and full is not None
+        assert max(live.shape[:2]) == TEXTURE_TEXELS < max(full.shape[:2]) <= 1024
+        assert library.texture_file(f"textures/{path.name}", "dataset") == path
+        assert library.texture_file(f"textures/{path.name}") == FURNITURE_DIR / "textures" / path.name

@@ -33,7 +33,9 @@ from ravh_sim.errors import UserError
 from ravh_sim.world.library import (
     CATALOG_FORMAT,
     CLEAR_GLASS_OPACITY,
+    FULL_SUFFIX,
     LibraryMaterial,
+    full_texture,
     is_clear_glass,
     material_kind,
     piece_labels,
@@ -61,6 +63,21 @@ TABLEWARE_TRIANGLES = 400
 MIN_TRIANGLES a pan became a cone and a teapot a box; they are seen close up on tables and worktops."""
 TEXTURE_TEXELS = 256
 """Longest texture side: fabric, wood and labels tile or cover a few hundred pixels in a frame."""
+DATASET_FACTOR = 3
+"""The dataset level of detail (``models/<id>.full.npz``, drawn by the ``dataset`` camera quality only),
+chosen by purpose: the kinds whose rule asks for it (``Rule.dataset``: appliances, sinks and
+washbasins, where what names them is small curved detail that the live budget facets: bowls, taps,
+handles, knobs) are simplified to DATASET_FACTOR times their live budget, never beyond the catalogue's
+own triangles nor DATASET_MAX_TRIANGLES. Not every model: a process drawing house 23 peaks at 567 MB
+at the live level; 3x for every model (268k triangles instead of 132k) took it to 681 MB, over the
+600 MB a node may use, for furniture whose live silhouette already holds at 640x480."""
+DATASET_MAX_TRIANGLES = 7500
+DATASET_MIN_GAIN = 1.5
+"""A model gets a dataset level only where it is materially finer: at least this many times the
+live model's triangles (otherwise the live model is the dataset level too)."""
+DATASET_TEXELS = 1024
+"""Longest side of a dataset-level texture (``textures/full/<live name>.jpg``, written only where the
+catalogue's texture is larger than TEXTURE_TEXELS)."""
 MAX_PER_TYPE = 4
 DROPPED_OPACITY = CLEAR_GLASS_OPACITY
 """Materials at most this opaque (clear glass panes) are left out: no sensor of ours sees them (the
@@ -75,7 +92,8 @@ class Rule:
     ``ids`` takes entries by catalogue id whatever their name (a pot the catalogue calls a bowl),
     ``skip_ids`` passes over entries whose name matches but whose model does not look the part (an oven
     that reads as a microwave); ``least``/``most`` bound the kind's triangle budget (default
-    MIN_TRIANGLES / TRIANGLE_BUDGET, read when used)."""
+    MIN_TRIANGLES / TRIANGLE_BUDGET, read when used); ``dataset``: its models get a finer dataset level
+    (DATASET_FACTOR)."""
     name: str
     categories: tuple[str, ...] = INDOOR
     exclude: str = r"$^"
@@ -83,6 +101,7 @@ class Rule:
     skip_ids: str = r"$^"
     least: int | None = None
     most: int | None = None
+    dataset: bool = False               # a finer dataset level (DATASET_FACTOR) is written for its models
 
 
 def triangle_budget(rule: Rule, longest_m: float) -> int:
@@ -94,7 +113,8 @@ def triangle_budget(rule: Rule, longest_m: float) -> int:
 
 
 def _appliance(name: str, categories: tuple[str, ...] = INDOOR, ids: str = r"$^", skip_ids: str = r"$^") -> Rule:
-    return Rule(name, categories, ids=ids, skip_ids=skip_ids, least=APPLIANCE_TRIANGLES, most=APPLIANCE_TRIANGLES)
+    return Rule(name, categories, ids=ids, skip_ids=skip_ids, least=APPLIANCE_TRIANGLES, most=APPLIANCE_TRIANGLES,
+                dataset=True)
 
 
 def _tableware(name: str, ids: str = r"$^", skip_ids: str = r"$^") -> Rule:
@@ -346,6 +366,8 @@ class Converted:
     materials: list[LibraryMaterial]
     textures: dict[str, bytes]           # file name -> JPEG bytes
     budget: int                          # the triangles it was simplified towards
+    full: tuple[trimesh.Trimesh, np.ndarray, np.ndarray] | None = None
+    """The dataset level (mesh, uvs, face material into ``materials``), where materially finer."""
 
 
 def convert(entry: Entry, zf: zipfile.ZipFile, rule: Rule = Rule("")) -> Converted:
@@ -366,11 +388,19 @@ def convert(entry: Entry, zf: zipfile.ZipFile, rule: Rule = Rule("")) -> Convert
     target = np.array([depth, width, height]) / 100.0
     vertices = (vertices - (lo + hi) / 2) * (target / np.maximum(hi - lo, 1e-9))
     budget = triangle_budget(rule, float(target.max()))
+    full_faces, full_material = faces, face_material
     mesh, uvs, face_material = _simplify(vertices, obj.uvs, faces, face_material, budget)
     materials, textures = _materials(obj.materials, np.unique(face_material))
     remap = {old: new for new, old in enumerate(np.unique(face_material))}
+    full = None
+    if rule.dataset and len(full_faces) >= DATASET_MIN_GAIN * len(mesh.faces):
+        known = np.isin(full_material, list(remap))      # a material the live level lost is left out of both
+        full_mesh, full_uvs, full_used = _simplify(vertices, obj.uvs, full_faces[known], full_material[known],
+                                                   min(DATASET_FACTOR * budget, DATASET_MAX_TRIANGLES))
+        if len(full_mesh.faces) >= DATASET_MIN_GAIN * len(mesh.faces):
+            full = (full_mesh, full_uvs, np.array([remap[m] for m in full_used], np.uint8))
     return Converted(mesh, uvs, np.array([remap[m] for m in face_material], np.uint8), materials, textures,
-                     budget)
+                     budget, full)
 
 
 def _simplify(vertices: np.ndarray, uvs: np.ndarray, faces: np.ndarray, face_material: np.ndarray,
@@ -405,6 +435,9 @@ def _simplify(vertices: np.ndarray, uvs: np.ndarray, faces: np.ndarray, face_mat
 
 
 def _materials(mtl: Sequence[dict], used: np.ndarray) -> tuple[list[LibraryMaterial], dict[str, bytes]]:
+    """The library materials of the used MTL materials and their textures: the live one
+    (``textures/<hash>.jpg``) and, where the catalogue's is larger, the dataset level's
+    (``textures/full/<hash>.jpg``, same hash)."""
     materials, textures = [], {}
     for index in used:
         m = mtl[int(index)]
@@ -414,6 +447,9 @@ def _materials(mtl: Sequence[dict], used: np.ndarray) -> tuple[list[LibraryMater
             if jpeg is not None:
                 texture = f"textures/{hashlib.sha1(jpeg).hexdigest()[:16]}.jpg"
                 textures[texture] = jpeg
+                full = _small_jpeg(m["map_Kd"], DATASET_TEXELS, larger_than=TEXTURE_TEXELS)
+                if full is not None:
+                    textures[full_texture(texture)] = full
         r, g, b = (float(np.clip(c, 0.0, 1.0)) for c in m["Kd"])
         roughness = float(np.clip(np.sqrt(2.0 / (max(m["Ns"], 0.0) + 2.0)), 0.05, 1.0))
         kind = material_kind(m["name"], texture is not None, float(m["d"]))
@@ -422,11 +458,13 @@ def _materials(mtl: Sequence[dict], used: np.ndarray) -> tuple[list[LibraryMater
     return materials, textures
 
 
-def _small_jpeg(data: bytes) -> bytes | None:
+def _small_jpeg(data: bytes, texels: int = TEXTURE_TEXELS, larger_than: int = 0) -> bytes | None:
+    """The image as a JPEG at most ``texels`` a side; None if it is not an image or not larger than
+    ``larger_than`` texels a side."""
     image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
-    if image is None:
+    if image is None or max(image.shape[:2]) <= larger_than:
         return None
-    scale = TEXTURE_TEXELS / max(image.shape[:2])
+    scale = texels / max(image.shape[:2])
     if scale < 1:
         image = cv2.resize(image, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
     ok, jpeg = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, 85])
@@ -453,7 +491,7 @@ def import_furniture(archives: Sequence[Path], out: Path, rules: dict[str, Rule]
     if out.exists():
         shutil.rmtree(out)
     (out / "models").mkdir(parents=True)
-    (out / "textures").mkdir()
+    (out / "textures" / "full").mkdir(parents=True)
     records: list[dict] = []
     written: dict[str, list[str]] = {}
     archives_open = {a: zipfile.ZipFile(a) for a in {e.archive for es in chosen.values() for e in es}}
@@ -472,7 +510,10 @@ def import_furniture(archives: Sequence[Path], out: Path, rules: dict[str, Rule]
                     smallest = (entry, converted)
             for entry, converted in kept or ([smallest] if smallest else []):
                 model_id = _model_id(kind, entry)
-                _write_model(out / "models" / f"{model_id}.npz", converted)
+                _write_model(out / "models" / f"{model_id}.npz", converted.mesh, converted.uvs,
+                             converted.face_material)
+                if converted.full is not None:
+                    _write_model(out / "models" / f"{model_id}{FULL_SUFFIX}", *converted.full)
                 for name, data in converted.textures.items():
                     (out / name).write_bytes(data)
                 records.append(_record(model_id, kind, entry, converted))
@@ -492,12 +533,12 @@ def _model_id(kind: str, entry: Entry) -> str:
     return f"{kind.replace('/', '_').lower()}__{slug}"
 
 
-def _write_model(path: Path, converted: Converted) -> None:
+def _write_model(path: Path, mesh: trimesh.Trimesh, uvs: np.ndarray, face_material: np.ndarray) -> None:
     buffer = io.BytesIO()
-    np.savez_compressed(buffer, vertices=converted.mesh.vertices.astype(np.float32),
-                        faces=converted.mesh.faces.astype(np.uint32), uvs=converted.uvs.astype(np.float32),
-                        face_material=converted.face_material.astype(np.uint8),
-                        face_piece=piece_labels(converted.mesh.vertices, converted.mesh.faces).astype(np.uint16))
+    np.savez_compressed(buffer, vertices=mesh.vertices.astype(np.float32),
+                        faces=mesh.faces.astype(np.uint32), uvs=uvs.astype(np.float32),
+                        face_material=face_material.astype(np.uint8),
+                        face_piece=piece_labels(mesh.vertices, mesh.faces).astype(np.uint16))
     path.write_bytes(buffer.getvalue())
 
 

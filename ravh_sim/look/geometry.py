@@ -5,7 +5,9 @@ own frame (procedural patterns are evaluated there, so a wood grain moves with i
 not swim when a door swings), a material index (ravh_sim.look.materials), the instance id that
 instance images store and a texture coordinate (library models' textures; zero elsewhere). Normals
 come from trimesh: smooth across gentle bends (cushions, bowls, lamp shades), flat across creases
-(box edges), decided per corner by a crease angle.
+(box edges), decided per corner by a crease angle. At the ``dataset`` level of detail library models
+are drawn at the library's dataset level (:func:`ravh_sim.world.library.dataset_model`), in the same
+place as the live model that collides.
 """
 from __future__ import annotations
 
@@ -18,6 +20,7 @@ import trimesh
 from ravh_sim.look.materials import MaterialTable
 from ravh_sim.poses import pose_matrix
 from ravh_sim.world import library
+from ravh_sim.world.library import Detail
 from ravh_sim.world.mesh import colours
 from ravh_sim.world.scene import Visual, World
 
@@ -74,31 +77,36 @@ def _scatter(normals: np.ndarray, valid: np.ndarray, count: int) -> np.ndarray:
 class SceneBuilder:
     """Builds the vertex array of a World, keeping each model's corners between rebuilds."""
 
-    def __init__(self, world: World, materials: MaterialTable) -> None:
-        self.world, self.materials = world, materials
+    def __init__(self, world: World, materials: MaterialTable, detail: Detail = "live") -> None:
+        self.world, self.materials, self.detail = world, materials, detail
         self._arrays: dict[int, BodyArrays] = {}           # id(mesh or fitted model) -> its arrays
         self._kept: dict[int, trimesh.Trimesh] = {}         # keeps those alive (ids stay unique)
 
     def build(self) -> np.ndarray:
-        """(3T, FLOATS_PER_VERTEX) float32 of every visible body, in instance order."""
-        chunks = []
+        """(3T, FLOATS_PER_VERTEX) float32 of every visible body, in instance order, written into one
+        array (no per-body copies: the dataset level of detail has several times the triangles)."""
+        shown_bodies = []
         for inst in self.world.instances:
             visual = self.world.visuals.get(inst.body)
-            if visual is None:
-                continue
-            chunks.append(self._body(visual, inst.name, inst.id))
+            if visual is not None:
+                shown_bodies.append((visual, inst.name, inst.id, self._corners(visual)))
+        out = np.empty((sum(n for *_, n in shown_bodies), FLOATS_PER_VERTEX), np.float32)
+        start = 0
+        for visual, name, instance_id, n in shown_bodies:
+            self._body(visual, name, instance_id, out[start:start + n])
+            start += n
         shown = {id(v.model if v.model is not None else v.mesh) for v in self.world.visuals.values()}
         for key in set(self._arrays) - shown:              # models swapped out: forget their arrays
             del self._arrays[key], self._kept[key]
-        return np.concatenate(chunks).astype(np.float32)
+        return out
 
-    def _body(self, visual: Visual, name: str, instance_id: int) -> np.ndarray:
+    def _corners(self, visual: Visual) -> int:
+        """How many corners a body has (its arrays made and kept on the way for a model)."""
         if visual.structure is not None:
-            mesh = visual.structure
-            corners = mesh.vertices[mesh.faces.ravel()]
-            normals = mesh.vertex_normals[mesh.faces.ravel()]
-            material = np.full(len(corners), self.materials.paint(visual.paint, visual.surface), np.float64)
-            return _pack(corners, normals, corners, material, instance_id, np.zeros((len(corners), 2)))
+            return 3 * len(visual.structure.faces)
+        return len(self._model_arrays(visual).local)
+
+    def _model_arrays(self, visual: Visual) -> BodyArrays:
         source = visual.model if visual.model is not None else visual.mesh
         assert source is not None
         key = id(source)
@@ -106,20 +114,36 @@ class SceneBuilder:
             if visual.model is not None:
                 record = library.record(source)
                 slots = np.array([self.materials.library(record.id, k, m) for k, m in enumerate(record.materials)])
-                self._arrays[key] = model_arrays(source, slots)
+                if self.detail == "dataset":
+                    arrays = model_arrays(library.dataset_model(source), slots)
+                    # kept in single precision: the dataset level has several times the corners
+                    arrays = BodyArrays(arrays.local.astype(np.float32), arrays.normals.astype(np.float32),
+                                        arrays.materials, arrays.uvs)
+                    self._arrays[key] = arrays
+                else:
+                    self._arrays[key] = model_arrays(source, slots)
             else:
                 self._arrays[key] = palette_arrays(source)
             self._kept[key] = source
-        arrays = self._arrays[key]
+        return self._arrays[key]
+
+    def _body(self, visual: Visual, name: str, instance_id: int, out: np.ndarray) -> None:
+        if visual.structure is not None:
+            mesh = visual.structure
+            corners = mesh.vertices[mesh.faces.ravel()]
+            normals = mesh.vertex_normals[mesh.faces.ravel()]
+            material = np.full(len(corners), self.materials.paint(visual.paint, visual.surface), np.float64)
+            _pack(out, corners, normals, corners, material, instance_id, np.zeros((len(corners), 2)))
+            return
+        arrays = self._model_arrays(visual)
         pose = pose_matrix(*self.world.object_pose(name))
         world_pos = arrays.local @ pose[:, :3].T + pose[:, 3]
-        return _pack(world_pos, arrays.normals @ pose[:, :3].T, arrays.local,
-                     arrays.materials.astype(np.float64), instance_id, arrays.uvs)
+        _pack(out, world_pos, arrays.normals @ pose[:, :3].T, arrays.local,
+              arrays.materials.astype(np.float64), instance_id, arrays.uvs)
 
 
-def _pack(position: np.ndarray, normal: np.ndarray, local: np.ndarray, material: np.ndarray,
-          instance_id: int, uvs: np.ndarray) -> np.ndarray:
-    out = np.empty((len(position), FLOATS_PER_VERTEX), np.float64)
+def _pack(out: np.ndarray, position: np.ndarray, normal: np.ndarray, local: np.ndarray, material: np.ndarray,
+          instance_id: int, uvs: np.ndarray) -> None:
+    """One body's corners into its rows of the vertex array (float32: what the GPU reads)."""
     out[:, 0:3], out[:, 3:6], out[:, 6:9] = position, normal, local
     out[:, 9], out[:, 10], out[:, 11:13] = material, instance_id, uvs
-    return out

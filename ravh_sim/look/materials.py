@@ -17,9 +17,8 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from ravh_sim.paths import FURNITURE_DIR
-from ravh_sim.world import paints
-from ravh_sim.world.library import LibraryMaterial, is_glass
+from ravh_sim.world import library, paints
+from ravh_sim.world.library import Detail, LibraryMaterial, is_glass
 from ravh_sim.world.palette import PALETTE
 
 RGB = tuple[float, float, float]
@@ -31,6 +30,12 @@ PATTERNS = ("plain", "plaster", "wood", "parquet", "tiles", "marble", "fabric", 
 PATTERN = {name: i for i, name in enumerate(PATTERNS)}
 TEXELS = 4                                   # texels per material row (see pack)
 LIBRARY_TEXELS = 256                         # side of every library texture in the texture array
+DATASET_TEXELS = 512
+"""Largest side of the texture array at the dataset level of detail: the largest texture in use,
+rounded up to a power of two, at most this. The library's dataset textures go up to 1024 texels
+(``textures/full``), but one layer costs its side squared in every copy (a house draws ~30 textures:
+512 is 24 MB an array, 1024 would be 94 MB, over what the 600 MB a node may use leaves); of the
+catalogues' textures 1 is larger than 600 texels, 86 are 512."""
 METAL_REFLECTANCE = 0.6                      # linear reflectance of a library model's steel and chrome
 
 
@@ -184,7 +189,8 @@ class MaterialTable:
     """Palette materials at fixed indices, then one slot per distinct (paint, surface) and library
     material in use; library textures get a layer each of one texture array."""
 
-    def __init__(self) -> None:
+    def __init__(self, detail: Detail = "live") -> None:
+        self.detail = detail                        # which level of the library's textures (library.DETAILS)
         self.materials: list[Material] = [palette_material(n, tuple(PALETTE.rgb[i]))
                                           for i, n in enumerate(PALETTE.names)]
         self._paint_slots: dict[tuple[str, str], int] = {}
@@ -222,16 +228,29 @@ class MaterialTable:
     def texture_layers(self) -> np.ndarray:
         """(layers, LIBRARY_TEXELS, LIBRARY_TEXELS, 3) uint8 RGB of the library textures in use (one
         white layer when there are none), each resized to the array's size, bottom row first (GL's
-        and OBJ's texture coordinates count v from the bottom)."""
-        layers = [np.full((LIBRARY_TEXELS, LIBRARY_TEXELS, 3), 255, np.uint8)]
-        if self.textures:
-            layers = [_texture_rgb(name) for name in self.textures]
-        return np.ascontiguousarray(np.stack(layers)[:, ::-1])
+        and OBJ's texture coordinates count v from the bottom). The array's side is LIBRARY_TEXELS, or
+        at the dataset level the largest texture's side rounded up to a power of two (at most
+        DATASET_TEXELS)."""
+        if not self.textures:
+            return np.full((1, LIBRARY_TEXELS, LIBRARY_TEXELS, 3), 255, np.uint8)
+        side = LIBRARY_TEXELS
+        if self.detail == "dataset":
+            largest = max(max(_texture_bgr(name, self.detail).shape[:2]) for name in self.textures)
+            side = int(min(DATASET_TEXELS, max(LIBRARY_TEXELS, 2 ** int(np.ceil(np.log2(largest))))))
+        out = np.empty((len(self.textures), side, side, 3), np.uint8)      # filled in place: no stacked copies
+        for layer, name in enumerate(self.textures):
+            out[layer] = _layer(_texture_bgr(name, self.detail), side)[::-1]
+        return out
 
 
-def _texture_rgb(name: str) -> np.ndarray:
-    bgr = cv2.imread(str(FURNITURE_DIR / name), cv2.IMREAD_COLOR)
+def _texture_bgr(name: str, detail: Detail) -> np.ndarray:
+    path = library.texture_file(name, detail)
+    bgr = cv2.imread(str(path), cv2.IMREAD_COLOR)
     if bgr is None:
-        raise FileNotFoundError(f"furniture texture {FURNITURE_DIR / name} is missing or unreadable")
-    size = (LIBRARY_TEXELS, LIBRARY_TEXELS)
-    return cv2.cvtColor(cv2.resize(bgr, size, interpolation=cv2.INTER_AREA), cv2.COLOR_BGR2RGB)
+        raise FileNotFoundError(f"furniture texture {path} is missing or unreadable")
+    return bgr
+
+
+def _layer(bgr: np.ndarray, side: int) -> np.ndarray:
+    interpolation = cv2.INTER_AREA if max(bgr.shape[:2]) >= side else cv2.INTER_CUBIC
+    return cv2.cvtColor(cv2.resize(bgr, (side, side), interpolation=interpolation), cv2.COLOR_BGR2RGB)

@@ -22,7 +22,9 @@ if TYPE_CHECKING:
     import moderngl
 
 BACKENDS = ("auto", "gl", "tiny")
-QUALITIES = ("realistic", "fast")
+QUALITIES = ("realistic", "fast", "dataset")
+"""``realistic``: the live stream's shading; ``fast``: one plain pass; ``dataset``: realistic shading of the
+library's dataset level of detail (finer models and textures: captures that make datasets)."""
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,8 @@ Per frame: the bodies whose boxes meet the view (gl_culling), the procedural sky
 windows, then the camera's side (gl_develop: metering, exposure or a sensor's development, read-back;
 a frame of non-finite radiance is refused, never returned black). ``fast`` quality draws
 every surface with the plain material in one pass, skips shadow look-ups and reflections, and
-confines lamps to their room instead.
+confines lamps to their room instead. ``dataset`` quality shades as ``realistic`` does and draws the
+library's dataset level of detail (finer models and textures, :mod:`ravh_sim.world.library`).
 
 What is lit and how brightly is decided by the scene's light model (ravh_sim.look.lighting, shared with
 every renderer); which of its parts to redo by the change report (ravh_sim.look.changes).
@@ -37,6 +38,7 @@ from ravh_sim.render.projection import look_at, orthographic, perspective, proje
 from ravh_sim.render.views import Development, RenderedViews
 from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import Light
+from ravh_sim.world.library import Detail
 from ravh_sim.world.scene import World
 from ravh_sim.world.topology import room_index_raster, room_links
 
@@ -78,10 +80,11 @@ class GLRenderer:
         self.gl = unlocked_gl()
         self.width, self.height, self.near, self.far = width, height, near, far
         self.K = np.asarray(K, np.float64)
-        self.shadows = quality == "realistic"
+        self.shadows = quality in ("realistic", "dataset")
         self.projection = projection_from_K(K, width, height, near, far)
-        self.materials = MaterialTable()
-        self.builder = SceneBuilder(world, self.materials)
+        detail: Detail = "dataset" if quality == "dataset" else "live"
+        self.materials = MaterialTable(detail)
+        self.builder = SceneBuilder(world, self.materials, detail)
         header = gl_programs.header()
         self._uniforms: dict[tuple[str, tuple[int, ...]], list[moderngl.Uniform]] = {}     # see _set
         self.scene_programs = {k: ctx.program(vertex_shader=header + source("scene.vert"),

@@ -67,7 +67,7 @@ class CameraSpec:
     near: float              # m
     far: float               # m
     rate: float              # Hz: frames published
-    quality: str = "realistic"   # realistic | fast (ravh_sim.render.backend.QUALITIES)
+    quality: str = "realistic"   # realistic | fast | dataset (ravh_sim.render.backend.QUALITIES)
     effects: tuple[tuple[str, Any], ...] = ()      # CameraOptions fields set by the profile
     sensor: imaging.SensorModel | None = None      # None: the ideal camera (no sensor model)
 

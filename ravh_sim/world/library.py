@@ -10,6 +10,12 @@ Format (``furniture/``, written by ``ravh import-furniture``, :mod:`ravh_sim.imp
   front along +x; ``faces`` (M, 3); ``uvs`` (N, 2); ``face_material`` (M,) into the materials;
   ``face_piece`` (M,): the connected piece (leg, seat, back...) each face belongs to.
 - ``textures/*.jpg``: base-colour textures, at most 256 texels a side.
+- The dataset level of detail (:data:`DETAILS`), drawn by the ``dataset`` camera quality only:
+  ``models/<id>.full.npz`` (same arrays and materials, up to 8x the triangles: the importer's
+  ``DATASET_FACTOR``) where it is materially finer than the live model, and ``textures/full/<name>``
+  (up to 1024 texels a side) where the catalogue's texture is larger than the live one. Where a
+  model or texture has none, the live one is the dataset level too. The dataset level is visual
+  only: colliders, footprints and fitting read the live model (:func:`dataset_model`).
 - ``ATTRIBUTION.md``: every model's creator and licence.
 
 A model is fitted into an object's box by :func:`fit`: scaled to the box's height where its
@@ -51,6 +57,12 @@ from ravh_sim.world.mesh import coloured, uv_visual
 from ravh_sim.world.palette import PALETTE
 
 CATALOG_FORMAT = "ravh_sim/furniture@1"
+DETAILS = ("live", "dataset")
+"""Levels of detail: ``live`` (the simulator's, what every sensor and collider reads) and ``dataset``
+(finer models and textures that dataset captures draw where the library has them)."""
+Detail = Literal["live", "dataset"]
+FULL_SUFFIX = ".full.npz"
+FIT_TOLERANCE = 1e-6                # m: a fitted model is an affine map of its library model within this
 MAX_STRETCH = 1.3
 """Largest per-axis stretch beyond a uniform scale: a sofa may grow a little wider, not turn into
 a bench."""
@@ -198,11 +210,34 @@ def models_of(kind: str) -> tuple[LibraryRecord, ...]:
     return tuple(r for r in catalog().models if r.kind == kind)
 
 
+def full_texture(texture: str) -> str:
+    """Where the dataset level of a library texture (``textures/<name>``) is: ``textures/full/<name>``."""
+    folder, _, name = texture.rpartition("/")
+    return f"{folder}/full/{name}"
+
+
+def texture_file(texture: str, detail: Detail = "live") -> Path:
+    """The file of a library material's texture at a level of detail (the live one where the
+    dataset level has none). House models' textures are absolute paths, which have one level."""
+    if detail == "dataset" and not Path(texture).is_absolute():
+        full = FURNITURE_DIR / full_texture(texture)
+        if full.exists():
+            return full
+    return FURNITURE_DIR / texture
+
+
+def has_dataset_level(model_id: str) -> bool:
+    """Whether the library has a finer dataset level of a model (``models/<id>.full.npz``)."""
+    return (FURNITURE_DIR / "models" / f"{model_id}{FULL_SUFFIX}").exists()
+
+
 @functools.lru_cache(maxsize=256)
-def load_model(model_id: str) -> trimesh.Trimesh:
-    """A library model in its own frame (centred box, z up, front along +x)."""
+def load_model(model_id: str, detail: Detail = "live") -> trimesh.Trimesh:
+    """A library model in its own frame (centred box, z up, front along +x), at a level of detail
+    (:data:`DETAILS`; the live model where the library has no dataset level of it)."""
     found = next(r for r in catalog().models if r.id == model_id)
-    with np.load(FURNITURE_DIR / "models" / f"{model_id}.npz") as data:
+    name = f"{model_id}{FULL_SUFFIX}" if detail == "dataset" and has_dataset_level(model_id) else f"{model_id}.npz"
+    with np.load(FURNITURE_DIR / "models" / name) as data:
         return _model(found, data["vertices"].astype(np.float64), data["faces"].astype(np.int64),
                       data["uvs"].astype(np.float32), {"material": data["face_material"].astype(np.int64),
                                                        "piece": data["face_piece"].astype(np.int64)})
@@ -229,6 +264,28 @@ def load_model_file(path: Path) -> trimesh.Trimesh:
                 for m in found.materials]
     return _model(found.model_copy(update={"materials": textured}), vertices, faces, uvs,
                   {"material": materials, "piece": pieces})
+
+
+def dataset_model(fitted: trimesh.Trimesh) -> trimesh.Trimesh:
+    """The dataset level of a fitted library model, placed as the fitted one is: the affine map from
+    the live library model to ``fitted`` (however it was fitted: :func:`fit` and a turn, a dressing
+    object's scale) applied to the dataset level's vertices. So both levels stand in the same box,
+    and the live model stays what collides (the dataset level is drawn only; its surface lies within
+    a few mm of the live one's). The fitted model itself where there is no finer level, where it is
+    not a library model, or where it is not an affine map of it (a house's own model)."""
+    model_id = record(fitted).id
+    if not any(r.id == model_id for r in catalog().models) or not has_dataset_level(model_id):
+        return fitted
+    live = load_model(model_id)
+    if len(live.vertices) != len(fitted.vertices):
+        return fitted
+    homogeneous = np.column_stack([live.vertices, np.ones(len(live.vertices))])
+    affine, *_ = np.linalg.lstsq(homogeneous, fitted.vertices, rcond=None)
+    if np.abs(homogeneous @ affine - fitted.vertices).max() > FIT_TOLERANCE:
+        return fitted
+    full = load_model(model_id, "dataset")
+    vertices = np.column_stack([full.vertices, np.ones(len(full.vertices))]) @ affine
+    return _model(record(fitted), vertices, full.faces, full.visual.uv, full.face_attributes)
 
 
 def fit_scale(natural: np.ndarray, size: np.ndarray) -> np.ndarray:
