@@ -13,6 +13,7 @@ import trimesh
 
 from ravh_sim.importers.furniture import (
     ABSOLUTE_BUDGET,
+    DATASET_FACTOR,
     OVER_BUDGET,
     RULES,
     TEXTURE_TEXELS,
@@ -137,11 +138,12 @@ def test_import_furniture_command_writes_the_library(tmp_path, capsys):
     assert main(["import-furniture", str(tmp_path / "nothing-here")]) == 2
 
 
-def test_importer_simplifies_to_the_budget(tmp_path, monkeypatch):
+def _ball_catalogue(tmp_path, monkeypatch):
+    """A catalogue of one 1,280-triangle ball, and an importer whose budget is 40 triangles."""
     import ravh_sim.importers.furniture as importer
     monkeypatch.setattr(importer, "TRIANGLE_BUDGET", 40)
     monkeypatch.setattr(importer, "MIN_TRIANGLES", 40)
-    sphere = __import__("trimesh").creation.icosphere(3)                # 1280 triangles
+    sphere = trimesh.creation.icosphere(3)                              # 1280 triangles
     obj = "\n".join([f"v {x} {y} {z}" for x, y, z in sphere.vertices * 50]
                     + ["f " + " ".join(str(i + 1) for i in f) for f in sphere.faces]) + "\n"
     archive = tmp_path / "Ball.sh3f"
@@ -149,6 +151,11 @@ def test_importer_simplifies_to_the_budget(tmp_path, monkeypatch):
         zf.writestr("PluginFurnitureCatalog.properties", "id#1=T#ball\nname#1=Ball\ncategory#1=Bedroom\n"
                     "model#1=/ball.obj\nwidth#1=50\ndepth#1=50\nheight#1=50\ncreator#1=X\nlicense#1=CC0\n")
         zf.writestr("ball.obj", obj)
+    return archive
+
+
+def test_importer_simplifies_to_the_budget(tmp_path, monkeypatch):
+    archive = _ball_catalogue(tmp_path, monkeypatch)
     import_furniture([archive], tmp_path / "out", {"Ball": Rule(r"ball", ("Bedroom",))}, progress=False)
     record = LibraryCatalog.model_validate_json((tmp_path / "out" / "catalog.json").read_text()).models[0]
     assert 20 <= record.triangles <= 48 and record.size == pytest.approx((0.5, 0.5, 0.5), abs=0.05)
@@ -320,17 +327,7 @@ def test_placed_library_models_lie_in_their_box_and_cover_their_pieces(houses):
 # --- the dataset level of detail -------------------------------------------------------------------
 
 def test_importer_writes_a_dataset_level_only_where_the_rule_asks_and_it_is_finer(tmp_path, monkeypatch):
-    import ravh_sim.importers.furniture as importer
-    monkeypatch.setattr(importer, "TRIANGLE_BUDGET", 40)
-    monkeypatch.setattr(importer, "MIN_TRIANGLES", 40)
-    sphere = trimesh.creation.icosphere(3)                              # 1280 triangles
-    obj = "\n".join([f"v {x} {y} {z}" for x, y, z in sphere.vertices * 50]
-                    + ["f " + " ".join(str(i + 1) for i in f) for f in sphere.faces]) + "\n"
-    archive = tmp_path / "Ball.sh3f"
-    with zipfile.ZipFile(archive, "w") as zf:
-        zf.writestr("PluginFurnitureCatalog.properties", "id#1=T#ball\nname#1=Ball\ncategory#1=Bedroom\n"
-                    "model#1=/ball.obj\nwidth#1=50\ndepth#1=50\nheight#1=50\ncreator#1=X\nlicense#1=CC0\n")
-        zf.writestr("ball.obj", obj)
+    archive = _ball_catalogue(tmp_path, monkeypatch)
     out = tmp_path / "out"
     import_furniture([archive], out, {"Ball": Rule(r"ball", ("Bedroom",), dataset=True),
                                       "Orb": Rule(r"ball", ("Bedroom",))}, progress=False)
@@ -340,7 +337,7 @@ def test_importer_writes_a_dataset_level_only_where_the_rule_asks_and_it_is_fine
         full = data["faces"]
         assert np.ptp(data["vertices"], axis=0) == pytest.approx((0.5, 0.5, 0.5), abs=0.02)
         assert set(data["face_material"].tolist()) == {0}
-    assert importer.DATASET_FACTOR * ball.triangles * 0.8 <= len(full) <= importer.DATASET_FACTOR * 40 * 1.05
+    assert DATASET_FACTOR * ball.triangles * 0.8 <= len(full) <= DATASET_FACTOR * 40 * 1.05
     # a second import reproduces both levels byte for byte
     again = tmp_path / "again"
     import_furniture([archive], again, {"Ball": Rule(r"ball", ("Bedroom",), dataset=True),
