@@ -46,6 +46,7 @@ from ravh_sim.world.house import House, HouseObject, Room
 from ravh_sim.world.instances import build_instances
 from ravh_sim.world.solids import Placed, _fitted, _piece_bounds, object_parts
 from ravh_sim.world.structure import solid_walls
+from ravh_sim.world.topology import room_links
 
 LEVELS = ("none", "tidy", "lived-in")
 DRESSING_TAG = "dressing"
@@ -352,7 +353,6 @@ class _Scene:
                 self.walls.append(_Obstacle(_rect(((ax + bx) / 2, (ay + by) / 2), (max(w.length, 0.01), w.thickness),
                                                   math.atan2(by - ay, bx - ax)), w.z0, w.z1))
         self.dressed: list[_Obstacle] = []
-        from ravh_sim.world.topology import room_links
         self.keep_free = [lk.position for lk in room_links(house)] + [d.position[:2] for d in house.doors] + [
             house.station.position[:2]]
         self._triangles: dict[str, np.ndarray] = {}

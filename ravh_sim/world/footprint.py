@@ -17,7 +17,7 @@ from typing import Any
 from ravh_sim.errors import FileFieldError
 from ravh_sim.files import atomic_write
 from ravh_sim.poses import quaternion_from_yaw
-from ravh_sim.world.dressing import slots
+from ravh_sim.world.dressing import Dressed, dressing, slots
 from ravh_sim.world.geometry import polygon_centroid
 from ravh_sim.world.house import House
 from ravh_sim.world.instances import STRUCTURE_KINDS, Instance, build_instances, mask_color
@@ -33,7 +33,7 @@ def dressing_instances(house: House, seed: int) -> list[Instance]:
                      mask_color(s.instance)) for s in slots(house, seed)]
 
 
-def dressing_pose(dressed: Any) -> dict[str, Any]:
+def dressing_pose(dressed: Dressed) -> dict[str, Any]:
     """A placed dressing object's footprint fields (:class:`ravh_sim.world.dressing.Dressed`)."""
     slot = dressed.slot
     return {"position": _r(dressed.position), "orientation": _r(quaternion_from_yaw(dressed.yaw)),
@@ -72,7 +72,6 @@ def make_footprint(house: House, settings: Resolved) -> dict[str, Any]:
         if inst.name in settings.lights:
             row["on"] = settings.lights[inst.name]
         rows.append(row)
-    from ravh_sim.world.dressing import dressing
     for dressed in dressing(house, settings.models, settings.dressing, settings.seed):
         slot = dressed.slot
         rows.append({"id": slot.instance, "name": slot.id, "kind": "dressing",

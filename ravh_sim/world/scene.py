@@ -31,6 +31,7 @@ import pybullet as pb
 import trimesh
 
 from ravh_sim.poses import quaternion_from_yaw
+from ravh_sim.world.dressing import dressing
 from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances, dressing_instances
 from ravh_sim.world.house import House, HouseObject, Wall
 from ravh_sim.world.library import record
@@ -314,7 +315,6 @@ class World:
         """Show the dressing of ``level`` as the layout for object ``models`` places it; every other
         dressing body is parked out of the house like an open door's leaf (a body is made when first
         shown and kept; its look leaves :attr:`visuals` while parked, so renderers skip it)."""
-        from ravh_sim.world.dressing import dressing
         shown = {d.id: d for d in dressing(self.house, models, level, self.state.seed)}
         c = self.client
         for inst in self.instances:
