@@ -25,6 +25,7 @@ from ravh_sim.nodes.launch import NODES
 from ravh_sim.nodes.launch import main as launch_node
 from ravh_sim.paths import FURNITURE_DIR, HOUSES_DIR
 from ravh_sim.raids.build import add_parser as add_dataset_parser
+from ravh_sim.raids.raid import QUALITY_PROFILES, RAID_QUALITY_HELP
 from ravh_sim.render.backend import BACKENDS, QUALITIES
 
 Command = Callable[[argparse.Namespace], int]
@@ -228,12 +229,15 @@ def cmd_render(args: argparse.Namespace) -> int:
 
 
 def cmd_gallery(args: argparse.Namespace) -> int:
-    from ravh_sim.raids.gallery import gallery, object_gallery
+    from ravh_sim.raids.gallery import dressing_gallery, gallery, object_gallery
     pose = tuple(args.pose) if args.pose else None
     if args.objects:
-        print(f"wrote {object_gallery(args.house, args.output, args.seed, args.renderer)}")
+        written = object_gallery(args.house, args.output, args.seed, args.renderer, args.quality)
+    elif args.dressing:
+        written = dressing_gallery(args.house, args.output, args.seed, pose, args.renderer, args.quality)
     else:
-        print(f"wrote {gallery(args.house, args.output, args.seed, pose, args.renderer)}")
+        written = gallery(args.house, args.output, args.seed, pose, args.renderer, args.quality)
+    print(f"wrote {written}")
     return 0
 
 
@@ -257,7 +261,7 @@ def cmd_raid(args: argparse.Namespace) -> int:
     for house in houses:
         out = args.out / f"house{int(house):02d}_raid{args.raid}" if args.all else args.out
         results.append(run_raid(house, args.raid, out, fast=args.fast, seed=args.seed,
-                                max_captures=args.max_captures, max_nodes=args.max_nodes))
+                                max_captures=args.max_captures, max_nodes=args.max_nodes, quality=args.quality))
         if Outcome.of(results[-1]["status"]) is Outcome.INTERRUPTED:       # Ctrl-C ends --all too
             break
     print(json.dumps(results if args.all else results[0], indent=1))
@@ -378,10 +382,15 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--pose", type=float, nargs=3, metavar=("X", "Y", "YAW"), default=None,
                    help="robot pose (default: the room-centre view with the most objects)")
-    p.add_argument("--objects", action="store_true",
-                   help="instead: sofas, beds, tables, chairs, fridges, ovens, toilets... each from the front, "
-                        "by day and at night")
+    sheet = p.add_mutually_exclusive_group()
+    sheet.add_argument("--objects", action="store_true",
+                       help="instead: sofas, beds, tables, chairs, fridges, ovens, toilets... each from the front, "
+                            "by day and at night")
+    sheet.add_argument("--dressing", action="store_true",
+                       help="instead: the view with no dressing beside lived-in, by day and at night")
     p.add_argument("--renderer", choices=BACKENDS, default="auto")
+    p.add_argument("--quality", choices=QUALITY_PROFILES, default="realistic",
+                   help="camera: realistic (default) or dataset (the library's finer models and textures)")
     p.add_argument("-o", "--output", type=Path, required=True, help="PNG file")
     p.set_defaults(func=cmd_gallery)
 
@@ -395,6 +404,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=None, help="default: house * 10 + raid")
     p.add_argument("--max-captures", type=int, default=0, help="stop after this many captures (0: no limit)")
     p.add_argument("--max-nodes", type=int, default=0, help="grid raids: visit only this many nodes (0: all)")
+    p.add_argument("--quality", choices=QUALITY_PROFILES, default="realistic", help=RAID_QUALITY_HELP)
     p.set_defaults(func=cmd_raid)
 
     p = sub.add_parser("bench", help="measure speed; prints JSON with --json")

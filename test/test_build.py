@@ -12,7 +12,10 @@ import tempfile
 import time
 from pathlib import Path
 
+import cv2
+import numpy as np
 import pytest
+import yaml
 from conftest import ROOT, subprocess_env
 
 import ravh_sim
@@ -110,7 +113,7 @@ def test_a_resume_redoes_a_raid_recorded_with_other_parameters(tmp_path):
     first = again(max_captures=5)
     recorded = json.loads((folder / "raid.json").read_text())["build"]
     assert recorded == {"seed": 201, "preset": recorded["preset"], "max_captures": 5, "max_nodes": 0,
-                        "engine": "direct", "version": ravh_sim.__version__}
+                        "engine": "direct", "quality": "realistic", "version": ravh_sim.__version__}
     assert recorded["preset"]["behaviour"] == "wanderer" and first["raids"][0]["captures"] == 5
     stamp = (folder / "raid.json").stat().st_mtime_ns
 
@@ -125,6 +128,18 @@ def test_a_resume_redoes_a_raid_recorded_with_other_parameters(tmp_path):
     other_seed = again(max_captures=8, seed=3)
     assert redone == [("house20/raid1", f"seed 201, asked for {raid_seed(20, 1, 3)}")]
     assert Dataset(folder).meta["raid"]["build"]["seed"] == raid_seed(20, 1, 3) == other_seed["raids"][0]["seed"]
+
+    live = {kind: [cv2.imread(str(p), cv2.IMREAD_UNCHANGED) for p in sorted((folder / kind).iterdir())]
+            for kind in ("rgb", "mask")}
+    finer = again(max_captures=8, seed=3, quality="dataset")     # the dataset camera: its own profile
+    assert redone == [("house20/raid1", "quality realistic, asked for dataset")]
+    assert yaml.safe_load((folder / "raid_settings.yaml").read_text())["agents"][0]["profile"] == "giraff_dataset"
+    assert finer["raids"][0]["captures"] == 8 and len(_complete(folder)) == 8
+    sharper = {kind: [cv2.imread(str(p), cv2.IMREAD_UNCHANGED) for p in sorted((folder / kind).iterdir())]
+               for kind in ("rgb", "mask")}
+    assert any(not np.array_equal(a, b) for a, b in zip(live["rgb"], sharper["rgb"]))   # other models drawn
+    for a, b in zip(live["mask"], sharper["mask"]):           # the same instances in the same pixels
+        assert np.mean(a != b) < 0.02
 
     summary = json.loads((folder / "raid.json").read_text())   # a raid of an older ravh_sim: no parameters
     del summary["build"]

@@ -3,10 +3,12 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import cv2
+import numpy as np
 import pytest
 
 from ravh_sim.nav.navigation import Navigation
-from ravh_sim.raids.gallery import _preset, object_views
+from ravh_sim.raids.gallery import LABEL_PX, _preset, dressing_gallery, object_views
 from ravh_sim.robot.profile import load_profile
 from ravh_sim.sensors.camera import SmartCamera
 from ravh_sim.world.house import load_house
@@ -54,3 +56,23 @@ def test_the_object_is_whole_in_the_frame_and_fills_a_share_of_it(house15):
         assert edge / outline <= MAX_EDGE_SHARE, (name, edge / outline)
         assert mask.mean() >= MIN_FILL, (name, mask.mean())
         assert shot.blocked < 0.2 and abs(shot.azimuth) <= 1.6, (name, shot)
+
+
+def test_the_dressing_sheet_shows_the_dressing_beside_the_bare_house(tmp_path):
+    """``ravh gallery --dressing``: a 2 x 2 sheet from one pose; the lived-in panels differ from the bare
+    ones (by day and at night) where dressing is in view, and nowhere else much."""
+    house = load_house(23)
+    pose = (2.3, -10.4, -1.8)                   # the living room's sofa and table (the README's sheet)
+    sheet = cv2.cvtColor(cv2.imread(str(dressing_gallery(23, tmp_path / "sheet.png", pose=pose))), cv2.COLOR_BGR2RGB)
+    width, height = 640, 480
+    assert sheet.shape[1] == 2 * width and sheet.shape[0] == 2 * (height + LABEL_PX)
+    with World(house, _preset(house, 0, 0, "lived-in")) as world:
+        dressing = {i.id for i in world.instances if i.kind == "dressing"}
+        seen = SmartCamera(world, load_profile().camera).capture(*pose).instance
+    shows_dressing = np.isin(seen, list(dressing))
+    assert shows_dressing.mean() > 0.01
+    day_bare, day_dressed = sheet[:height, :width], sheet[:height, width:]
+    changed = np.any(np.abs(day_bare.astype(int) - day_dressed.astype(int)) > 24, axis=-1)
+    assert changed[shows_dressing].mean() > 0.5 and changed[~shows_dressing].mean() < 0.1
+    night = sheet[height + LABEL_PX:2 * height + LABEL_PX]
+    assert np.mean(np.any(night[:, :width] != night[:, width:], axis=-1)) > 0.01

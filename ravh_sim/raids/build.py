@@ -6,7 +6,7 @@ or the ROS engine (``ravh raid``'s three processes). Raids run on a local proces
 tasks on a cluster (``--ray ADDRESS``; ``pip install ravh_sim[ray]``) whose nodes share OUT.
 
 The output folder is the only state: a raid whose raid.json says it finished with the parameters
-asked for now (seed, preset, max captures and nodes, engine, ravh_sim version: :func:`parameters`)
+asked for now (seed, preset, max captures and nodes, engine, camera quality, ravh_sim version: :func:`parameters`)
 is skipped; one recorded with other parameters is named with what differs and run again, and any
 other raid folder is an interrupted or failed run and is deleted before the raid runs again, so a
 build can be stopped at any moment and resumed with the same command. Progress counts the lines of the
@@ -35,7 +35,7 @@ from ravh_sim.dataset import layout
 from ravh_sim.errors import UserError
 from ravh_sim.paper import RAID_COLUMNS, TABLE2, table2
 from ravh_sim.raids.outcome import Outcome
-from ravh_sim.raids.raid import PRESETS, preset_settings, run_raid
+from ravh_sim.raids.raid import PRESETS, QUALITY_PROFILES, RAID_QUALITY_HELP, preset_settings, run_raid
 
 ENGINES = ("direct", "ros")
 POLL_S = 0.5
@@ -58,6 +58,7 @@ class BuildOptions:
     engine: str = "direct"
     max_captures: int = 0               # per raid, 0: no limit (small test builds)
     max_nodes: int = 0                  # grid raids: only this many nodes, 0: all
+    quality: str = "realistic"          # the camera's: a key of ravh_sim.raids.raid.QUALITY_PROFILES
 
 
 def parse_numbers(text: str, valid: Iterable[int], what: str) -> list[int]:
@@ -114,11 +115,11 @@ def parameters(job: Job, options: BuildOptions) -> dict[str, Any]:
     preset = PRESETS[job.raid]
     return {"seed": job.seed, "preset": dict(preset.__dict__), "max_captures": options.max_captures,
             "max_nodes": options.max_nodes if preset.behaviour == "grid" else 0, "engine": options.engine,
-            "version": __version__}
+            "quality": options.quality, "version": __version__}
 
 
 PARAMETER_NAMES = {"seed": "seed", "preset": "preset", "max_captures": "max captures", "max_nodes": "max nodes",
-                   "engine": "engine", "version": "ravh_sim version"}
+                   "engine": "engine", "quality": "quality", "version": "ravh_sim version"}
 
 
 def difference(summary: dict[str, Any], wanted: dict[str, Any]) -> str | None:
@@ -155,13 +156,13 @@ def run_job(job: Job, root: Path, options: BuildOptions) -> dict[str, Any]:
     recorded = {"build": parameters(job, options)}          # in raid.json: what a resume compares
     if options.engine == "ros":
         return run_raid(job.house, job.raid, out, fast=True, seed=job.seed, max_captures=options.max_captures,
-                        max_nodes=options.max_nodes, quiet=True, meta=recorded)
+                        max_nodes=options.max_nodes, quiet=True, meta=recorded, quality=options.quality)
     (out / "logs").mkdir(parents=True)
     with _output_to(out / "logs" / "direct.log"):
         from ravh_sim.raids.direct import GridSpec, WandererSpec, record
         spec = GridSpec(max_nodes=options.max_nodes) if preset.behaviour == "grid" else WandererSpec()
-        return record(out, job.house, spec, settings=preset_settings(preset, job.seed), seed=job.seed,
-                      max_captures=options.max_captures,
+        return record(out, job.house, spec, settings=preset_settings(preset, job.seed, options.quality),
+                      seed=job.seed, max_captures=options.max_captures,
                       raid={"raid": job.raid, "preset": preset.__dict__, **recorded})
 
 
@@ -187,7 +188,7 @@ def _output_to(log: Path) -> Iterator[None]:
 def build(root: Path, houses: list[int], raids: list[int], workers: int = 1, engine: str = "direct",
           seed: int | None = None, ray_address: str | None = None, max_captures: int = 0,
           max_nodes: int = 0, show_progress: bool = True,
-          on_redo: Callable[[str, str], None] | None = None) -> dict[str, Any]:
+          on_redo: Callable[[str, str], None] | None = None, quality: str = "realistic") -> dict[str, Any]:
     """Run every (house, raid) not yet finished under ``root`` with these parameters; returns every
     raid's summary, the names of those that failed and of those redone because they had been
     recorded with other parameters (each also passed to ``on_redo(name, why)`` before anything runs)."""
@@ -195,9 +196,11 @@ def build(root: Path, houses: list[int], raids: list[int], workers: int = 1, eng
         raise UserError(f"--engine: unknown engine {engine!r}; valid: {', '.join(ENGINES)}")
     if workers < 1:
         raise UserError(f"--workers must be >= 1, got {workers}")
+    if quality not in QUALITY_PROFILES:
+        raise UserError(f"--quality: unknown quality {quality!r}; valid: {', '.join(QUALITY_PROFILES)}")
     root.mkdir(parents=True, exist_ok=True)
     jobs = [Job(h, r, raid_seed(h, r, seed)) for h in houses for r in raids]
-    options = BuildOptions(engine, max_captures, max_nodes)
+    options = BuildOptions(engine, max_captures, max_nodes, quality)
     done: dict[Job, dict[str, Any]] = {}
     redone: dict[str, str] = {}
     for job in jobs:
@@ -415,6 +418,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="run the raids as tasks on this Ray cluster ('auto': the local one)")
     p.add_argument("--max-captures", type=int, default=0, help="stop each raid after N captures (0: no limit)")
     p.add_argument("--max-nodes", type=int, default=0, help="grid raids: visit only N nodes (0: all)")
+    p.add_argument("--quality", choices=QUALITY_PROFILES, default="realistic", help=RAID_QUALITY_HELP)
     p.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     p.set_defaults(func=cmd_build)
     e = commands.add_parser("export", help="datasets under DIR in a detector-training format (COCO)")
@@ -444,7 +448,7 @@ def cmd_build(args: argparse.Namespace) -> int:
         print(f"ravh: raid {name} was recorded with other parameters, redoing it: {why}", file=sys.stderr)
 
     result = build(args.out, houses, raids, args.workers, args.engine, args.seed, args.ray,
-                   args.max_captures, args.max_nodes, args.progress, say_redo)
+                   args.max_captures, args.max_nodes, args.progress, say_redo, args.quality)
     print(summary_table(result))
     redone = f", {len(result['redone'])} redone with other parameters" if result["redone"] else ""
     print(f"{len(result['raids'])} raids in {args.out} ({result['skipped']} already there{redone}), "

@@ -6,10 +6,12 @@ shows the most labelled objects from at least MIN_VIEW_DEPTH_M away (counted on 
 """
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -32,23 +34,33 @@ WIDE_VIEW_DEPTH_M = 4.0          # views this deep or deeper count their objects
 LABEL_PX = 30
 
 
-def best_view(world: World, camera: SmartCamera) -> tuple[float, float, float]:
-    """The room-centre pose and heading that sees the most labelled objects from far enough back
-    (the station's pose when no candidate qualifies)."""
-    objects = {inst.id for inst in world.instances if inst.kind == "object"}
+def best_view(world: World, camera: SmartCamera, kinds: tuple[str, ...] = ("object",),
+              stand_back: bool = False) -> tuple[float, float, float]:
+    """The room-centre pose and heading that sees the most instances of ``kinds`` from far enough
+    back (the station's pose when no candidate qualifies); ``stand_back`` also tries the points
+    halfway from each room's centre to its corners, where a photographer takes in the whole room,
+    those the robot fits at (navigation free space)."""
+    from ravh_sim.nav.navigation import Navigation
+    from ravh_sim.world.state import WorldState
+    free = Navigation(world.house, WorldState(world.state.settings()), load_profile()).map() if stand_back else None
+    counted = {inst.id for inst in world.instances if inst.kind in kinds}
     best, best_count = None, -1.0
     for room in world.house.rooms:
         x, y = polygon_centroid(room.floor)
         if not room.contains(x, y):
             continue
-        for k in range(8):
-            pose = (x, y, k * math.pi / 4)
+        spots = [(x, y)] + ([((x + cx) / 2, (y + cy) / 2) for cx, cy in room.floor
+                             if free is not None and free.is_free((x + cx) / 2, (y + cy) / 2)])
+        for (sx, sy), k in itertools.product(spots, range(8)):
+            if not room.contains(sx, sy):
+                continue
+            pose = (sx, sy, k * math.pi / 4)
             capture = camera.capture(*pose)
             depth = float(np.nanmedian(capture.depth)) if np.isfinite(capture.depth).any() else 0.0
             if depth < MIN_VIEW_DEPTH_M:
                 continue
             counts = np.bincount(capture.instance.ravel())
-            seen = sum(1 for i in np.flatnonzero(counts >= MIN_OBJECT_PIXELS) if i in objects)
+            seen = sum(1 for i in np.flatnonzero(counts >= MIN_OBJECT_PIXELS) if i in counted)
             score = seen * min(1.0, depth / WIDE_VIEW_DEPTH_M)
             if score > best_count:
                 best, best_count = pose, score
@@ -59,17 +71,15 @@ def best_view(world: World, camera: SmartCamera) -> tuple[float, float, float]:
 
 
 def gallery(house_number: int, output: Path, seed: int = 0,
-            pose: tuple[float, float, float] | None = None, renderer: str = "auto") -> Path:
-    """Write the contact sheet (3 x 2 panels) to ``output``; returns it."""
+            pose: tuple[float, float, float] | None = None, renderer: str = "auto",
+            quality: str = "realistic") -> Path:
+    """Write the contact sheet (3 x 2 panels) to ``output``; returns it. ``quality``: the camera's."""
     house = load_house(house_number)
     profile = load_profile()
     with World(house, _preset(house, 0, seed)) as world:
         appearance = Appearance(world)
-        if pose is None:
-            scout = SmartCamera(world, replace(profile.camera, quality="fast"), backend=renderer)
-            pose = best_view(world, scout)
-            scout.close()
-        camera = SmartCamera(world, profile.camera, backend=renderer)
+        pose = pose or _best_view(world, renderer)
+        camera = SmartCamera(world, replace(profile.camera, quality=quality), backend=renderer)
         panels = []
         for k, preset in enumerate(PRESETS):
             appearance.apply(_preset(house, k, seed))
@@ -80,18 +90,56 @@ def gallery(house_number: int, output: Path, seed: int = 0,
         panels.append(_labelled(camera.capture(*pose).rgb,
                                 f"random: sun {world.state.sun_angle:.0f} deg, paint, models, lights"))
         camera.close()
-    sheet = np.vstack([np.hstack(panels[:3]), np.hstack(panels[3:])])
+    return _write(np.vstack([np.hstack(panels[:3]), np.hstack(panels[3:])]), output)
+
+
+def dressing_gallery(house_number: int, output: Path, seed: int = 0,
+                     pose: tuple[float, float, float] | None = None, renderer: str = "auto",
+                     quality: str = "realistic") -> Path:
+    """Write a 2 x 2 sheet to ``output``: one view with no dressing (the paper's objects only) beside
+    the default ``lived-in`` dressing, by day (raid 0's look) and at night (raid 4's); returns it. The
+    view, unless given, is the one that shows the most objects, dressing included."""
+    house = load_house(house_number)
+    profile = load_profile()
+    with World(house, _preset(house, 0, seed, DRESSING_SHOWN[-1])) as world:
+        appearance = Appearance(world)
+        pose = pose or _best_view(world, renderer, ("object", "dressing"), True)
+        camera = SmartCamera(world, replace(profile.camera, quality=quality), backend=renderer)
+        rows = []
+        for raid, look in LOOKS:
+            row = []
+            for dressing in DRESSING_SHOWN:
+                appearance.apply(_preset(house, raid, seed, dressing))
+                row.append(_labelled(camera.capture(*pose).rgb, f"dressing {dressing}, {look}"))
+            rows.append(np.hstack(row))
+        camera.close()
+    return _write(np.vstack(rows), output)
+
+
+def _best_view(world: World, renderer: str, *how: Any) -> tuple[float, float, float]:
+    """:func:`best_view` (``how``: its options) counted on a fast render."""
+    scout = SmartCamera(world, replace(load_profile().camera, quality="fast"), backend=renderer)
+    try:
+        return best_view(world, scout, *how)
+    finally:
+        scout.close()
+
+
+def _write(sheet: np.ndarray, output: Path) -> Path:
     output.parent.mkdir(parents=True, exist_ok=True)
     if not cv2.imwrite(str(output), cv2.cvtColor(sheet, cv2.COLOR_RGB2BGR)):
         raise OSError(f"could not write {output}")
     return output
 
 
-def _preset(house, raid: int, seed: int) -> Resolved:
-    """The resolved settings of a raid preset: the defaults with the preset's sections over them."""
+def _preset(house, raid: int, seed: int, dressing: str | None = None) -> Resolved:
+    """The resolved settings of a raid preset: the defaults with the preset's sections over them
+    (and ``dressing`` over the preset's, when given)."""
     settings = load_settings()
     for section, values in preset_settings(PRESETS[raid], seed).items():
         settings[section] = {**settings[section], **values} if isinstance(values, dict) else values
+    if dressing is not None:
+        settings["dressing"] = dressing
     return resolve(settings, house, seed)
 
 
@@ -107,7 +155,8 @@ SHOWCASE_TYPES = ("Sofa", "Armchair", "Bed", "Table", "Chair", "Refrigerator", "
                   "Washbasin", "Desk", "Closet")
 """The object types ``ravh gallery --objects`` shows: what a detector trained on photos must find."""
 LOOKS = ((0, "day"), (4, "night"))
-"""The raids whose look the object sheet shows, side by side, from one pose."""
+"""The raids whose look the object and dressing sheets show, side by side, from one pose."""
+DRESSING_SHOWN = ("none", "lived-in")
 OBJECTS_PER_TYPE = 4              # objects of a type tried for a view (the house's order)
 VIEW_AZIMUTHS_DEG = (0.0, -20.0, 20.0, -40.0, 40.0, -60.0, 60.0, 90.0, -90.0)
 """Where the photographer may stand, as an angle from the object's front (its sides last)."""
@@ -304,9 +353,10 @@ def object_views(world: World, camera: SmartCamera, types: tuple[str, ...] = SHO
     return views
 
 
-def object_gallery(house_number: int, output: Path, seed: int = 0, renderer: str = "auto") -> Path:
+def object_gallery(house_number: int, output: Path, seed: int = 0, renderer: str = "auto",
+                   quality: str = "realistic") -> Path:
     """Write a sheet of the showcase types of a house, each seen from the front by day (raid 0's
-    look) and at night with the lights on (raid 4's), side by side."""
+    look) and at night with the lights on (raid 4's), side by side. ``quality``: the camera's."""
     house = load_house(house_number)
     profile = load_profile()
     with World(house, _preset(house, 0, seed)) as world:
@@ -315,7 +365,7 @@ def object_gallery(house_number: int, output: Path, seed: int = 0, renderer: str
         views = [(name, shot.pose) for name, shot in
                  object_views(world, scout, looks=[_preset(house, raid, seed) for raid, _ in LOOKS])]
         scout.close()
-        camera = SmartCamera(world, profile.camera, backend=renderer)
+        camera = SmartCamera(world, replace(profile.camera, quality=quality), backend=renderer)
         panels: dict[str, list[np.ndarray]] = {name: [] for name, _ in views}
         for raid, look in LOOKS:
             appearance.apply(_preset(house, raid, seed))
@@ -325,8 +375,4 @@ def object_gallery(house_number: int, output: Path, seed: int = 0, renderer: str
     pairs = [np.hstack(p) for p in panels.values()]
     rows = [np.hstack(pairs[k:k + 2]) if k + 1 < len(pairs) else np.hstack([pairs[k], np.zeros_like(pairs[k])])
             for k in range(0, len(pairs), 2)]
-    sheet = cv2.resize(np.vstack(rows), None, fx=0.5, fy=0.5, interpolation=cv2.INTER_AREA)
-    output.parent.mkdir(parents=True, exist_ok=True)
-    if not cv2.imwrite(str(output), cv2.cvtColor(sheet, cv2.COLOR_RGB2BGR)):
-        raise OSError(f"could not write {output}")
-    return output
+    return _write(cv2.resize(np.vstack(rows), None, fx=0.5, fy=0.5, interpolation=cv2.INTER_AREA), output)

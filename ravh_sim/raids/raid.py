@@ -30,6 +30,7 @@ from pathlib import Path
 import yaml
 from tqdm import tqdm
 
+from ravh_msgs_py.names import DEFAULT_AGENT, DEFAULT_PROFILE
 from ravh_sim.dataset import layout
 from ravh_sim.errors import UserError
 from ravh_sim.nodes.common import ros_domain_id
@@ -42,6 +43,11 @@ POLL_S = 0.5
 RECORDER_START_S = 120.0         # the recorder is ready once the sim's footprint reached it
 DISCOVERY_S = 2.0
 HANDOVER_GRACE_S = 30.0          # wall seconds the recorder gets to store the behaviour's last captures
+# a raid's camera quality -> the robot profile that has it (config/robots/): the live level, or the
+# furniture library's finer models and textures for datasets (ravh_sim.world.library DETAILS)
+QUALITY_PROFILES = {"realistic": DEFAULT_PROFILE, "dataset": "giraff_dataset"}
+RAID_QUALITY_HELP = ("camera: realistic (the live level, default) or dataset (the furniture library's finer "
+                     "models and textures: slower, sharper)")
 
 
 @dataclass(frozen=True)
@@ -63,33 +69,39 @@ PRESETS = (
 )
 
 
-def preset_settings(preset: RaidPreset, seed: int) -> dict:
-    """The settings file of a raid preset (keys as in config/default.yaml)."""
+def preset_settings(preset: RaidPreset, seed: int, quality: str = "realistic") -> dict:
+    """The settings file of a raid preset (keys as in config/default.yaml); ``quality`` (a key of
+    QUALITY_PROFILES) picks the robot profile, so the footprint records which camera made the raid."""
+    if quality not in QUALITY_PROFILES:
+        raise UserError(f"unknown raid quality {quality!r}; valid: {', '.join(QUALITY_PROFILES)}")
     return {"seed": seed,
             "lights": {"sun_angle": preset.sun, "ceiling": preset.ceiling, "lamps": preset.lamps},
             "paint": {"walls": preset.paint, "floors": preset.paint},
             "models": {"all": preset.models},
-            "dressing": "none"}          # the paper's raids: the paper's objects, nothing else
+            "dressing": "none",          # the paper's raids: the paper's objects, nothing else
+            "agents": [{"name": DEFAULT_AGENT, "profile": QUALITY_PROFILES[quality]}]}
 
 
 def run_raid(house: int | str, raid: int, out: Path, fast: bool = False, seed: int | None = None,
              max_captures: int = 0, max_nodes: int = 0, timeout: float = 3600.0, quiet: bool = False,
-             meta: dict | None = None) -> dict:
+             meta: dict | None = None, quality: str = "realistic") -> dict:
     """Run one raid into the new folder ``out``; returns its summary (also written to ``out/raid.json``).
-    ``meta``: more keys for dataset.json's ``raid`` and the summary (a build's parameters)."""
+    ``meta``: more keys for dataset.json's ``raid`` and the summary (a build's parameters); ``quality``:
+    the camera's (QUALITY_PROFILES)."""
     if not 0 <= raid < len(PRESETS):
         raise UserError(f"unknown raid {raid}; valid: {', '.join(map(str, range(len(PRESETS))))}")
     preset = PRESETS[raid]
     home = load_house(house)                  # by number, name or path (the sim is given the same words)
     number = home.number
     seed = check_seed(number * 10 + raid if seed is None else seed)
+    settings = preset_settings(preset, seed, quality)
     logs = out / "logs"
     settings_path = out / "raid_settings.yaml"
     with _writing(out):
         if out.exists() and (not out.is_dir() or any(out.iterdir())):
             raise UserError(f"{out} exists and is not empty; raid into a new folder")
         logs.mkdir(parents=True)
-        layout.atomic_write(settings_path, yaml.safe_dump(preset_settings(preset, seed), sort_keys=False).encode())
+        layout.atomic_write(settings_path, yaml.safe_dump(settings, sort_keys=False).encode())
     domain, how = ros_domain_id(os.getpid() * 7 + number * 5 + raid)
     if not quiet:
         print(f"ravh raid: ROS_DOMAIN_ID {domain} ({how})", file=sys.stderr)
@@ -100,7 +112,8 @@ def run_raid(house: int | str, raid: int, out: Path, fast: bool = False, seed: i
                       else ["--captures", "10", "--max-nodes", str(max_nodes)])
     start = time.monotonic()
     imported = {"house_name": home.name, "attribution": home.attribution} if home.name else {}
-    raid_meta = {"house": number, **imported, "raid": raid, "preset": preset.__dict__, "seed": seed, "fast": fast,
+    raid_meta = {"house": number, **imported, "raid": raid, "preset": preset.__dict__, "seed": seed,
+                 "quality": quality, "fast": fast,
                  "ros_domain_id": domain, **(meta or {})}
     captures, given = out / layout.CAPTURES_JSONL, logs / "behaviour_captures.jsonl"
     status = Outcome.DONE.status()

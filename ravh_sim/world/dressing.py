@@ -53,6 +53,8 @@ DRESSING_TAG = "dressing"
 REST_TOLERANCE = 0.0015       # m: a support's triangle this close above an object's bottom is its surface
 FLOOR_CLEARANCE = 0.9         # m: a floor object's centre from a doorway's or passage's centre, the station
 CANDIDATES = 24               # positions tried per slot
+REST_SAMPLES = 9              # vertical lines per side of a footprint that find its support (5 missed
+REST_INSET = 0.003            # a mattress rising 2 mm between them), this far inside its edges
 
 
 @dataclass(frozen=True)
@@ -103,7 +105,7 @@ SHELF = (_s("Book", "Dressing/book", (0.17, 0.24, 0.25), 2, 6, facing="support")
          _s("Vase", "Dressing/vase Decoration/vase", (0.14, 0.14, 0.24), 0, 1))
 BED = (_s("Duvet", "Dressing/duvet", (1.4, 1.6, 0.12), 1, 1, stretch=True, flat=0.08, touching=0.3,
           facing="support"),
-       _s("Pillow", "Dressing/pillow", (0.45, 0.7, 0.14), 1, 2, flat=0.05, touching=0.4, facing="support"))
+       _s("Pillow", "Dressing/pillow", (0.45, 0.7, 0.14), 1, 2, flat=0.05, touching=0.7, facing="support"))
 SOFA = (_s("Cushion", "Dressing/cushion", (0.2, 0.45, 0.45), 1, 3, flat=0.04, touching=0.4, facing="support"),
         _s("Throw", "Dressing/throw", (0.6, 1.0, 0.07), 0, 1, stretch=True, flat=0.05, touching=0.4,
            facing="support"))
@@ -213,7 +215,7 @@ def slots(house: House, seed: int) -> tuple[Slot, ...]:
     for window in house.windows:
         wide = window.width > 1.3
         wet = house.room(window.room).type in ("Bathroom", "Kitchen")
-        draw = random.Random(f"{seed}/dressing/{window.id}").random()
+        draw = random.Random(f"{seed}/dressing/{house.number}/{window.id}").random()
         spec = CURTAIN if not wet and (wide or draw < 0.7) or wet and wide and draw < 0.3 else BLIND
         if spec is CURTAIN and _blocked_below(house, window):
             spec = BLIND                           # furniture under the window: a blind, not long curtains
@@ -238,7 +240,7 @@ def slots(house: House, seed: int) -> tuple[Slot, ...]:
             continue
         name = f"{spec.type}_{numbers.get(spec.type, 0)}"
         numbers[spec.type] = numbers.get(spec.type, 0) + 1
-        rng = random.Random(f"{seed}/dressing/{support}/{spec.type}/{k}")
+        rng = random.Random(f"{seed}/dressing/{house.number}/{support}/{spec.type}/{k}")   # houses differ
         record = records[rng.randrange(len(records))]
         tidy = k < spec.tidy
         out.append(Slot(name, spec.type, first_instance + len(out), room_id, support, spec, record.id,
@@ -416,10 +418,11 @@ def crossings(triangles: np.ndarray, points: np.ndarray) -> np.ndarray:
     return np.where(inside, z, np.nan)
 
 
-def footprint_points(centre: tuple[float, float], size: Sequence[float], yaw: float, n: int = 5) -> np.ndarray:
-    """(n*n, 2) points spread over a yawed rectangle, 1 mm inside its edges."""
-    u = np.linspace(-size[0] / 2 + 0.001, size[0] / 2 - 0.001, n)
-    v = np.linspace(-size[1] / 2 + 0.001, size[1] / 2 - 0.001, n)
+def footprint_points(centre: tuple[float, float], size: Sequence[float], yaw: float, n: int = 5,
+                     inset: float = 0.001) -> np.ndarray:
+    """(n*n, 2) points spread over a yawed rectangle, ``inset`` m inside its edges."""
+    u = np.linspace(-size[0] / 2 + inset, size[0] / 2 - inset, n)
+    v = np.linspace(-size[1] / 2 + inset, size[1] / 2 - inset, n)
     uu, vv = (g.ravel() for g in np.meshgrid(u, v))
     c, s = math.cos(yaw), math.sin(yaw)
     return np.stack([centre[0] + c * uu - s * vv, centre[1] + s * uu + c * vv], axis=1)
@@ -430,7 +433,7 @@ def rest_height(triangles: np.ndarray, centre: tuple[float, float], size: Sequen
     """Where an object of ``size`` at ``centre``/``yaw`` rests on ``triangles`` at or below ``below``:
     its bottom on the highest crossing under its footprint, or None when part of the support would be
     inside it or too little of its footprint touches (see the module)."""
-    points = footprint_points(centre, size, yaw)
+    points = footprint_points(centre, size, yaw, REST_SAMPLES, REST_INSET)
     lo, hi = points.min(axis=0) - 1e-3, points.max(axis=0) + 1e-3
     tri_lo, tri_hi = triangles[:, :, :2].min(axis=1), triangles[:, :, :2].max(axis=1)
     near = np.all((tri_hi >= lo) & (tri_lo <= hi), axis=1)
@@ -459,7 +462,7 @@ def layout(house: House, models: tuple[tuple[str, int], ...], seed: int) -> tupl
     out = []
     # the tidy slots first, so the tidy level is exactly what lived-in places of them
     for slot in sorted(slots(house, seed), key=lambda s: (not s.tidy, s.instance)):
-        rng = random.Random(f"{seed}/dressing/pose/{slot.id}")
+        rng = random.Random(f"{seed}/dressing/{house.number}/pose/{slot.id}")
         pose = _place(scene, slot, rng)
         if pose is None:
             continue

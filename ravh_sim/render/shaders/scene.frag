@@ -111,11 +111,15 @@ Surface pattern(vec3 base, vec3 accent, float rough, float metal, float scale, f
     }
 #elif PATTERN_ID == PATTERN_FABRIC
     {
-        float weave = sin(uv.x * scale * PI) * sin(uv.y * scale * PI);
+        // The weave fades out where a thread pair spans more than about a pixel: drawn finer, it
+        // aliased into moire across beds and sofas. Its average (t = 0.5) stays.
+        vec2 footprint = fwidth(uv * scale);
+        float resolved = clamp(1.5 - 1.5 * max(footprint.x, footprint.y), 0.0, 1.0);
+        float weave = sin(uv.x * scale * PI) * sin(uv.y * scale * PI) * resolved;
         float t = 0.5 + 0.5 * weave;
         float mottle = fbm(p * 7.0);
         s.albedo = mix(accent, base, 0.7 + 0.3 * t) * (1.0 + (mottle - 0.5) * variation);
-        s.height = t * 0.5 + 0.5 * grain(p * scale * 0.25);
+        s.height = t * 0.5 + 0.5 * grain(p * scale * 0.25) * resolved;
     }
 #elif PATTERN_ID == PATTERN_LEATHER
     {
@@ -157,10 +161,12 @@ Surface pattern(vec3 base, vec3 accent, float rough, float metal, float scale, f
     }
 #elif PATTERN_ID == PATTERN_METAL
     {
-        float brushed = grain(vec3(uv.x * 3.0, uv.y * scale, 0.0));
-        s.albedo = base * (0.92 + 0.16 * brushed);
-        s.roughness = rough * (0.8 + 0.4 * brushed);
-        s.height = brushed * 0.3;
+        // Brushed streaks: smooth value noise stretched along the brushing, a faint relief (a hashed
+        // cell per streak tilted the normal at every cell edge, and reflections broke into stripes).
+        float brushed = vnoise(vec3(uv.x * 3.0, uv.y * scale, 0.0));
+        s.albedo = base * (0.94 + 0.12 * brushed);
+        s.roughness = rough * (0.85 + 0.3 * brushed);
+        s.height = brushed * 0.05;
     }
 #elif PATTERN_ID == PATTERN_TEXTURED
     {
