@@ -275,3 +275,91 @@ def test_at_most_two_bottles_a_worktop(houses):
     per = Counter(d.slot.support for d in dressing(house, settings.models, "lived-in", settings.seed)
                   if d.slot.type == "Bottle")
     assert per and max(per.values()) <= 2
+
+
+def _shelf_books(house, seed: int = 0):
+    settings = _settings(house, "lived-in", seed)
+    return [d for d in dressing(house, settings.models, "lived-in", settings.seed)
+            if d.slot.type == "Book" and dressing_module._support_kind(house.object(d.slot.support)) == "Shelf"]
+
+
+def test_books_stand_in_rows_on_bookcase_boards(houses):
+    """House 15's bookcases hold rows of books on several boards, inside the case: each row's footprint
+    on its board (dense vertical lines find the board at its bottom) and nothing of the case inside
+    it (so clear of the board above); each row several books standing side by side."""
+    house = houses[15]
+    rows = _shelf_books(house)
+    assert len(rows) >= 4
+    boards = {(d.slot.support, round(d.position[2] - d.slot.size[2] / 2, 2)) for d in rows}
+    assert len(boards) >= 3, "rows on several boards, not only on top"
+    scene = dressing_module._Scene(house, _settings(house, "lived-in").models)
+    inside = 0
+    for d in rows:
+        depth, width, height = d.slot.size
+        bottom = d.position[2] - height / 2
+        points = dressing_module.footprint_points(d.position[:2], (depth, width), d.yaw, 25, 0.003)
+        z = dressing_module.crossings(scene.triangles(d.slot.support), points)
+        assert not np.any((z > bottom + 0.002) & (z < bottom + height)), f"{d.id} cuts into its case"
+        under = np.where(z <= bottom + 0.002, z, -np.inf).max(axis=1)
+        assert np.mean(np.abs(under - bottom) < 0.003) > 0.9, f"{d.id} does not rest on its board"
+        top = scene.placed[d.slot.support].position[2] + scene.placed[d.slot.support].extent()[1][2]
+        inside += bottom < top - 0.05
+        model = d.placed().model
+        assert model is not None and model.face_attributes["piece"].max() + 1 >= 5, "a row of books"
+        assert np.ptp(model.vertices[:, 2]) > np.ptp(model.vertices[:, 0]) / 2
+    assert inside >= 3, "rows stand inside the case, between its boards"
+
+
+def test_desks_hold_short_stacks_of_books(houses):
+    """Books on desks and tables lie flat in stacks of 2-4, each book flatter than it is wide."""
+    from ravh_sim.world import made_objects
+    stacks = []
+    for number in (15, 23):
+        house = houses[number]
+        settings = _settings(house, "lived-in")
+        stacks += [d for d in dressing(house, settings.models, "lived-in", settings.seed)
+                   if d.slot.type == "Book" and house.object(d.slot.support).type in ("Desk", "Table")]
+    assert len(stacks) >= 4
+    for d in stacks:
+        assert made_objects.is_made(d.slot.model_id) and d.slot.size[2] < made_objects.ROW_HEIGHT
+        model = d.placed().model
+        assert model is not None
+        pieces = model.face_attributes["piece"]
+        assert 2 <= pieces.max() + 1 <= 4
+        for k in range(pieces.max() + 1):
+            extent = np.ptp(model.vertices[np.unique(model.faces[pieces == k])], axis=0)
+            assert extent[2] < min(extent[:2]) / 2, "lying flat"
+
+
+@pytest.mark.parametrize("kind", ["book", "dish_rack"])
+def test_made_models_bound_their_box_and_are_seeded(kind):
+    """Every made model fills exactly its box, stays small, shows two materials or more (pages and
+    covers; tray, plates and cups), and rebuilds the same from its id and box."""
+    from ravh_sim.world import made_objects
+    sizes = {"book": [(0.2, 0.45, 0.22), (0.2, 0.26, 0.13), (0.26, 0.2, 0.1)], "dish_rack": [(0.42, 0.36, 0.24)]}
+    for record in made_objects.records(f"Dressing/{kind}"):
+        for size in sizes[kind]:
+            model = made_objects.model(record.id, size)
+            assert np.allclose(np.ptp(model.vertices, axis=0), size, atol=1e-9)
+            assert np.allclose(model.vertices.min(axis=0), -np.asarray(size) / 2, atol=1e-9)
+            assert len(model.faces) < 600 and model.is_winding_consistent
+            materials = model.face_attributes["material"]
+            assert len(np.unique(materials)) >= 2 and materials.max() < len(model.metadata["record"].materials)
+            again = made_objects.model.__wrapped__(record.id, size)
+            assert np.array_equal(again.vertices, model.vertices) and np.array_equal(again.faces, model.faces)
+
+
+def test_a_kitchen_has_one_dish_rack_by_its_sink(houses):
+    house = houses[15]
+    settings = _settings(house, "lived-in")
+    racks = [d for d in dressing(house, settings.models, "lived-in", settings.seed) if d.slot.type == "DishRack"]
+    sinks = [o for o in house.objects if o.type == "Sink"]
+    assert len(racks) == len(sinks) == 1
+    assert house.object(racks[0].slot.support).room == sinks[0].room
+
+
+def test_book_rows_and_stacks_are_seeded(houses):
+    house = houses[15]
+    first = [(d.id, d.slot.model_id, d.position, d.yaw) for d in _shelf_books(house)]
+    assert first == [(d.id, d.slot.model_id, d.position, d.yaw) for d in _shelf_books(house)]
+    assert first != [(d.id, d.slot.model_id, d.position, d.yaw) for d in _shelf_books(house, seed=5)]

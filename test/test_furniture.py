@@ -321,3 +321,30 @@ def test_facing_distance_is_measured_from_the_box_side():
     walls = [((2.0, -1.0), (2.0, 1.0))]
     assert side_distances((0.0, 0.0), 0.0, (1.0, 0.5, 1.0), walls)[0] == pytest.approx(1.5)
     assert side_distances((0.0, 0.0), np.pi / 2, (1.0, 0.5, 1.0), walls)[3] == pytest.approx(1.75)
+
+
+@pytest.mark.parametrize('yaw', [0.0, 1.2, -np.pi / 2])
+def test_an_appliance_in_a_corner_opens_into_the_room_not_into_its_neighbour(yaw):
+    """A washing machine with walls 5 cm behind it (-x) and 4 cm at its end (-y), a sink unit touching
+    its other end (+y): the nearest wall alone puts its back to -y and its door towards the unit; the
+    blockers turn the door to +x, the open side."""
+    center, size = np.array([0.0, 0.0]), (0.6, 0.6, 0.85)
+    walls = [wall_beside(center, yaw, 2, 0.05, size), wall_beside(center, yaw, 3, 0.04, size)]
+    unit = [wall_beside(center, yaw, 1, 0.0, size)]
+    assert front_axis('WashingMachine') == front_axis('Refrigerator') == 'door'
+    assert choose_facing(center, yaw, size, walls, front='door') == 1
+    assert choose_facing(center, yaw, size, walls, front='door', blockers=unit) == 0
+    enclosed = unit + [wall_beside(center, yaw, 0, 0.1, size)]          # no side open: the walls decide
+    assert choose_facing(center, yaw, size, walls, front='door', blockers=enclosed) == 1
+
+
+def test_an_appliance_keeps_its_front_where_a_turned_model_would_fit_better(houses):
+    """Its box's proportions never turn an appliance's door away from the side chosen for it (house
+    3's washing machine was turned a quarter, its door to the wall 9 cm away)."""
+    from ravh_sim.world.solids import object_parts
+    house = houses[3]
+    washer = house.object_by_id["WashingMachine_0"]
+    placed = object_parts(house, washer, None)
+    walls = [(w.a, w.b) for w in house.walls if w.room == washer.room and w.kind != "lintel"]
+    side = round((placed.front - washer.yaw) / (np.pi / 2)) % 4
+    assert side_distances(washer.position[:2], washer.yaw, washer.size, walls)[side] > 0.3

@@ -2,7 +2,8 @@
 
 The appearance knob ``dressing`` (:class:`ravh_msgs_py.appearance.Looks`: ``none``, ``tidy`` or
 ``lived-in``) adds catalogue objects to a house: plates, bowls, cups, a fruit bowl and a vase on
-tables; pans, a kettle, bottles and a dish rack on worktops; books, boxes and plants on shelves;
+tables; pans, a kettle, bottles and a dish rack (one a kitchen, by its sink) on worktops; rows of
+books, boxes and plants on the boards of bookcases (racks) and shelves, stacks of books on desks;
 pillows and a duvet on beds, cushions and a throw on sofas; towels in bathrooms; rugs by sofas and
 beds; curtains or blinds at windows; plants in corners; more pictures on the walls.
 
@@ -14,12 +15,14 @@ How a layout is made (:func:`layout`), in plain Python, with no pybullet:
   level keeps it (``tidy`` is a subset of ``lived-in``). A slot's id (``Plate_0``; numbered after the
   house's own objects of that type, so ``Cup_3`` follows the house's ``Cup_0..2``) and its instance id
   (after every instance of the house) never depend on the level or on the object models.
-- **Poses** depend on the supports' models (a table's model decides where its top is): each slot tries
-  seeded candidate positions on its support and takes the first that (a) rests on the support's
+- **Poses** depend on the supports' models (a table's model decides where its top is; a bookcase's, which
+  boards it has, :func:`_boards`): each slot tries seeded candidate positions on its support (on a
+  bookcase, at each of its boards) and takes the first that (a) rests on the support's
   real geometry, the fitted model's triangles, not its box (vertical lines through the object's
   footprint cross the support's triangles: the highest crossing under it is its bottom, nothing of
   the support lies inside it, and enough of its footprint touches), and (b) keeps clear of every other
-  object's pieces (:attr:`Placed.bounds`), the walls and every dressing object placed before it.
+  object's pieces (:attr:`Placed.bounds`; on a bookcase, of its own sides, back and dividers too), the
+  walls and every dressing object placed before it.
   Things on the floor keep clear of doorways, passages and the robot's station; rugs lie under
   nothing that stands on the floor. A slot with no room on its support is left out.
 
@@ -41,7 +44,7 @@ import numpy as np
 import trimesh
 from shapely.geometry import Point, Polygon
 
-from ravh_sim.world import library, soft_furnishings
+from ravh_sim.world import library, made_objects, soft_furnishings
 from ravh_sim.world.house import House, HouseObject, Room
 from ravh_sim.world.instances import build_instances
 from ravh_sim.world.solids import Placed, _fitted, _piece_bounds, object_parts
@@ -79,30 +82,33 @@ def _s(type_: str, kinds: str, box: tuple[float, float, float], tidy: int, lived
 
 
 # what each support holds; the kinds are the furniture library's (Dressing/... first, older kinds after)
+STACK = (0.26, 0.2, 0.1)       # a few books lying on a table or a desk (made_objects: box under ROW_HEIGHT)
 TABLE = (_s("FruitBowl", "Dressing/fruit_bowl", (0.32, 0.32, 0.16), 1, 1),
          _s("Vase", "Dressing/vase Decoration/vase", (0.18, 0.18, 0.32), 1, 1),
          _s("Plate", "Dressing/plate", (0.26, 0.26, 0.04), 0, 4),
          _s("Cup", "Dressing/cup Cup", (0.12, 0.12, 0.11), 0, 3),
          _s("Bowl", "Dressing/bowl", (0.17, 0.17, 0.08), 0, 1),
-         _s("Book", "Dressing/book", (0.24, 0.17, 0.05), 0, 1))
+         _s("Book", "Dressing/book", STACK, 0, 1, stretch=True))
 SMALL_TABLE = (_s("Vase", "Dressing/vase Decoration/vase", (0.16, 0.16, 0.28), 1, 1),
-               _s("Book", "Dressing/book", (0.24, 0.17, 0.05), 0, 2),
+               _s("Book", "Dressing/book", STACK, 0, 2, stretch=True),
                _s("Cup", "Dressing/cup Cup", (0.12, 0.12, 0.11), 0, 1),
                _s("Plant", "Dressing/plant Decoration", (0.2, 0.2, 0.25), 0, 1))
-DESK = (_s("Book", "Dressing/book", (0.24, 0.17, 0.05), 1, 3),
+DESK = (_s("Book", "Dressing/book", STACK, 1, 3, stretch=True),
         _s("Cup", "Dressing/cup Cup", (0.12, 0.12, 0.11), 0, 1),
         _s("Plant", "Dressing/plant Decoration", (0.2, 0.2, 0.25), 0, 1),
         _s("Box", "Dressing/box", (0.3, 0.25, 0.15), 0, 1))
-WORKTOP = (_s("Kettle", "Dressing/kettle", (0.22, 0.2, 0.26), 1, 1),
-           _s("DishRack", "Dressing/dish_rack", (0.45, 0.34, 0.16), 1, 1),
+WORKTOP = (_s("DishRack", "Dressing/dish_rack", (0.42, 0.36, 0.24), 1, 1, stretch=True, facing="support"),
+           _s("Kettle", "Dressing/kettle", (0.22, 0.2, 0.26), 1, 1),
            _s("Pan", "Dressing/pan", (0.45, 0.28, 0.1), 0, 1),
            _s("Bottle", "Dressing/bottle", (0.07, 0.07, 0.26), 0, 2),
            _s("Bowl", "Dressing/bowl", (0.17, 0.17, 0.08), 0, 1),
            _s("Cup", "Dressing/cup Cup", (0.12, 0.12, 0.11), 0, 2))
-SHELF = (_s("Book", "Dressing/book", (0.17, 0.24, 0.25), 2, 6, facing="support"),
-         _s("Box", "Dressing/box", (0.3, 0.3, 0.22), 1, 2, facing="support"),
-         _s("Plant", "Dressing/plant Decoration", (0.22, 0.22, 0.26), 1, 2),
-         _s("Vase", "Dressing/vase Decoration/vase", (0.14, 0.14, 0.24), 0, 1))
+# on a bookcase's or a shelf's boards (a row's width and height are made to measure: _box), wholly on
+# a board (touching), spines and box fronts to the room
+SHELF = (_s("Book", "Dressing/book", (0.2, 0.45, 0.22), 2, 6, stretch=True, touching=0.97, facing="support"),
+         _s("Box", "Dressing/box", (0.26, 0.3, 0.18), 1, 2, touching=0.97, facing="support"),
+         _s("Plant", "Dressing/plant Decoration", (0.2, 0.2, 0.2), 1, 2, touching=0.9),
+         _s("Vase", "Dressing/vase Decoration/vase", (0.14, 0.14, 0.2), 0, 1, touching=0.9))
 BED = (_s("Duvet", "Dressing/duvet", (1.4, 1.6, 0.12), 1, 1, stretch=True, flat=0.08, touching=0.3,
           facing="support"),
        _s("Pillow", "Dressing/pillow", (0.45, 0.7, 0.14), 1, 2, flat=0.05, touching=0.7, facing="support"))
@@ -122,6 +128,7 @@ SUPPORTS: dict[str, tuple[Spec, ...]] = {
 CORNER_ROOMS = ("LivingRoom", "KitchenLivingRoom", "Bedroom", "Office", "Hall", "Standard")
 ART_ROOMS = ("LivingRoom", "KitchenLivingRoom", "Bedroom", "Office", "Hall", "Corridor", "Standard",
              "DressingRoom", "Kitchen")
+SINGLE_BED = 1.2              # m: a bed this wide or narrower has one pillow, in its middle
 WALL_CENTRE = 1.5             # m above the floor: the centre of a picture
 TOWEL_TOP = 1.6               # m above the floor: a hanging towel's top
 
@@ -162,8 +169,9 @@ class Dressed:
 
     def placed(self) -> Placed:
         """The fitted model in its body frame and the body's pose, as :mod:`ravh_sim.world.solids` has it."""
-        if soft_furnishings.is_soft(self.slot.model_id):
-            fitted = soft_furnishings.model(self.slot.model_id, self.slot.size)
+        if soft_furnishings.is_soft(self.slot.model_id) or made_objects.is_made(self.slot.model_id):
+            made = soft_furnishings.model if soft_furnishings.is_soft(self.slot.model_id) else made_objects.model
+            fitted = made(self.slot.model_id, self.slot.size)
             bounds = _piece_bounds(fitted.vertices, fitted.faces, fitted.face_attributes["piece"])
         else:
             fitted, bounds = _fitted(self.slot.model_id, self.slot.size, 0)
@@ -171,10 +179,11 @@ class Dressed:
 
 
 def kind_models(spec: Spec) -> tuple[library.LibraryRecord, ...]:
-    """The library models of the first of the spec's kinds that has any, or else the soft models
-    made here (:mod:`ravh_sim.world.soft_furnishings`: pillows, duvets, cushions, throws); empty: none."""
+    """The library models of the first of the spec's kinds that has any, or else the models made here
+    (:mod:`ravh_sim.world.soft_furnishings`: pillows, duvets, cushions, throws;
+    :mod:`ravh_sim.world.made_objects`: books, dish racks); empty: none."""
     for kind in spec.kinds:
-        found = library.models_of(kind) or soft_furnishings.records(kind)
+        found = library.models_of(kind) or soft_furnishings.records(kind) or made_objects.records(kind)
         if found:
             return found
     return ()
@@ -198,6 +207,8 @@ def dressing(house: House, models: Mapping[str, int], level: str, seed: int) -> 
 def _support_kind(obj: HouseObject) -> str | None:
     if obj.type == "Table":
         return "Table/small" if library.kind_of(obj.type, obj.prefab) == "Table/small" else "Table"
+    if obj.type == "Standard":             # racks are bookcases (a TV bench is Standard/tv)
+        return "Shelf" if library.kind_of(obj.type, obj.prefab) == "Standard" else None
     return obj.type if obj.type in SUPPORTS else None
 
 
@@ -206,9 +217,15 @@ def slots(house: House, seed: int) -> tuple[Slot, ...]:
     """Every slot of ``house`` for ``seed``, in a fixed order (supports in the house's order, then
     windows, corners, walls; see the module)."""
     plan: list[tuple[str, str, Spec, int]] = []        # (room, support, spec, order)
+    racks = _dish_rack_counters(house)
     for obj in house.objects:
         kind = _support_kind(obj)
         for spec in SUPPORTS.get(kind or "", ()):
+            if spec.type == "DishRack" and obj.id not in racks:
+                continue
+            if spec.type == "Pillow" and min(obj.size[:2]) <= SINGLE_BED:     # one pillow on a single bed
+                plan.append((obj.room, obj.id, spec, 0))
+                continue
             plan += [(obj.room, obj.id, spec, k) for k in range(spec.lived_in)]
         if obj.type in ("Sofa", "Bed"):
             plan.append((obj.room, obj.id, RUG, 0))
@@ -246,6 +263,18 @@ def slots(house: House, seed: int) -> tuple[Slot, ...]:
         out.append(Slot(name, spec.type, first_instance + len(out), room_id, support, spec, record.id,
                         _size(record.id, spec, _box(house, support, spec)), tidy, k))
     return tuple(out)
+
+
+def _dish_rack_counters(house: House) -> set[str]:
+    """The worktop that holds a kitchen's one dish rack: in each room with a sink, the counter nearest
+    it (not the sink's own, which has the basin in it) wide and deep enough for a rack."""
+    out = set()
+    for sink in (o for o in house.objects if o.type == "Sink"):
+        counters = [o for o in house.objects if o.type == "Counter" and o.room == sink.room
+                    and "sink" not in o.prefab.lower() and min(o.size[:2]) >= 0.5]
+        if counters:
+            out.add(min(counters, key=lambda o: math.dist(o.position[:2], sink.position[:2])).id)
+    return out
 
 
 def _blocked_below(house: House, window) -> bool:
@@ -300,8 +329,12 @@ def _box(house: House, support: str, spec: Spec) -> tuple[float, float, float]:
     if obj is None:
         return spec.box
     long, short = max(obj.size[:2]), min(obj.size[:2])
-    if spec.type == "Duvet":
-        return (0.62 * long, 0.96 * short, spec.box[2])
+    if spec.type == "Duvet":             # over the foot, leaving a pillow's room at the head of a short bed
+        return (min(0.62 * long, long - 0.95), 0.96 * short, spec.box[2])
+    if spec.type == "Book" and spec.box[2] >= made_objects.ROW_HEIGHT:
+        # a row across part of a board, as tall as the case's boards stand apart (about an eighth of it)
+        return (spec.box[0], round(float(np.clip(0.45 * long, 0.26, 0.5)), 3),
+                round(float(np.clip(0.12 * obj.size[2], 0.13, 0.27)), 3))
     if spec.type == "Throw":
         return (min(0.5, 0.5 * short), min(1.0, 0.45 * long), spec.box[2])
     if spec.type == "Rug":
@@ -319,7 +352,7 @@ def _box(house: House, support: str, spec: Spec) -> tuple[float, float, float]:
 def _size(model_id: str, spec: Spec, box_size: tuple[float, float, float]) -> tuple[float, float, float]:
     """The model's box when scaled into ``box_size``: uniformly (keeping its proportions), or as the
     library fits furniture where the spec stretches (a duvet to a bed, a curtain to a window)."""
-    if soft_furnishings.is_soft(model_id):          # made to measure
+    if soft_furnishings.is_soft(model_id) or made_objects.is_made(model_id):          # made to measure
         return tuple(round(float(v), 4) for v in box_size)      # type: ignore[return-value]
     natural = np.maximum(np.ptp(library.load_model(model_id).vertices, axis=0), 1e-4)
     box = np.asarray(box_size, np.float64)
@@ -372,18 +405,19 @@ class _Scene:
     def clear(self, outline: Polygon, z0: float, z1: float, skip: str = "") -> bool:
         """Whether a box of ``outline`` from z0 to z1 keeps clear of every object but ``skip``, the
         walls and the dressing placed so far."""
-        def hits(obstacles: Sequence[_Obstacle]) -> bool:
-            return any(o.z0 < z1 and o.z1 > z0 and o.outline.intersects(outline)
-                       and o.outline.intersection(outline).area > 1e-7 for o in obstacles)
-
         cx, cy = outline.centroid.x, outline.centroid.y
         for oid, obstacles in self.obstacles.items():
             if oid == skip:
                 continue
             p = self.placed[oid].position
-            if abs(p[0] - cx) < 4.0 and abs(p[1] - cy) < 4.0 and hits(obstacles):
+            if abs(p[0] - cx) < 4.0 and abs(p[1] - cy) < 4.0 and _hits(obstacles, outline, z0, z1):
                 return False
-        return not hits(self.walls) and not hits(self.dressed)
+        return not _hits(self.walls, outline, z0, z1) and not _hits(self.dressed, outline, z0, z1)
+
+
+def _hits(obstacles: Sequence[_Obstacle], outline: Polygon, z0: float, z1: float) -> bool:
+    return any(o.z0 < z1 and o.z1 > z0 and o.outline.intersects(outline)
+               and o.outline.intersection(outline).area > 1e-7 for o in obstacles)
 
 
 def _piece_rects(p: Placed) -> Iterator[tuple[tuple, float, float]]:
@@ -508,12 +542,8 @@ def _on_support(scene: _Scene, slot: Slot, obj: HouseObject, rng: random.Random
     d, w, h = slot.size
     reach = max(d, w) / 2
     c, s = math.cos(p.yaw), math.sin(p.yaw)
-    top = p.position[2] + hi[2]
-    levels = [top]
-    if obj.type == "Shelf":                     # every board under the top, where the object fits
-        zs = crossings(triangles, np.array([_body_to_house(p, (lo + hi)[:2] / 2)]))[0]
-        levels = sorted({round(float(z), 4) for z in zs[np.isfinite(zs)]}, reverse=True)
-        rng.shuffle(levels)
+    shelf = _support_kind(obj) == "Shelf"
+    levels = _boards(triangles, p, lo, hi) if shelf else [p.position[2] + hi[2]]
     dining = obj.type == "Table" and _support_kind(obj) == "Table"
     places = _places(scene, obj, p, lo, hi, reach, rng) if dining and slot.type == "Plate" else []
     for attempt in range(CANDIDATES):
@@ -528,16 +558,42 @@ def _on_support(scene: _Scene, slot: Slot, obj: HouseObject, rng: random.Random
             u, v = _soft_spot(slot, p, lo, hi, rng, attempt)
         x, y = p.position[0] + c * u - s * v, p.position[1] + s * u + c * v
         yaw = front if slot.spec.facing == "support" else rng.uniform(-math.pi, math.pi)
-        if obj.type == "Shelf" and slot.spec.facing == "support":
-            yaw = front
-        level = levels[attempt % len(levels)]
-        bottom = rest_height(triangles, (x, y), (d, w, h), yaw, level, slot.spec)
-        if bottom is None or bottom < p.position[2] + lo[2] + 0.02:
-            continue
         outline = _rect((x, y), (d, w), yaw)
-        if scene.clear(outline, bottom + REST_TOLERANCE, bottom + h, skip=obj.id):
-            return (x, y, bottom + h / 2), yaw
+        for level in rng.sample(levels, len(levels)) if shelf else levels:
+            bottom = rest_height(triangles, (x, y), (d, w, h), yaw, level, slot.spec)
+            if bottom is None or bottom < p.position[2] + lo[2] + 0.02:
+                continue
+            z0, z1 = bottom + REST_TOLERANCE, bottom + h
+            # on a shelf, clear of the case's own sides, back and dividers too (between the rest lines)
+            if scene.clear(outline, z0, z1, skip=obj.id) and not (shelf and _hits(scene.obstacles[obj.id], outline,
+                                                                                   z0, z1)):
+                return (x, y, bottom + h / 2), yaw
     return None
+
+
+BOARD_SHARE = 0.15            # of the lines down through a shelf's footprint that cross a board
+BOARD_GAP = 0.03              # m: a crossing this close under a board's top is its underside
+
+
+def _boards(triangles: np.ndarray, p: Placed, lo: np.ndarray, hi: np.ndarray) -> list[float]:
+    """The tops of a bookcase's or a shelf's boards (house frame), highest first: heights where many of
+    a grid of vertical lines over its footprint cross it (one line at its centre may meet a divider,
+    or a model's own books), each board's underside left out. Things rest on them by
+    :func:`rest_height`, which keeps them under the board above."""
+    u, v = np.meshgrid(np.linspace(lo[0], hi[0], 7)[1:-1], np.linspace(lo[1], hi[1], 13)[1:-1])
+    points = np.array([_body_to_house(p, q) for q in np.stack([u.ravel(), v.ravel()], axis=1)])
+    zs = crossings(triangles, points)
+    found: dict[float, float] = {}
+    for row in zs:
+        for key in {round(float(z), 2) for z in row[np.isfinite(row)]}:
+            found[key] = found.get(key, 0.0) + 1.0 / len(points)
+    common = sorted((z for z in zs[np.isfinite(zs)].ravel() if found[round(float(z), 2)] >= BOARD_SHARE),
+                    reverse=True)
+    tops: list[float] = []
+    for z in common:
+        if not tops or tops[-1] - z > BOARD_GAP:
+            tops.append(float(z))
+    return tops or [p.position[2] + hi[2]]
 
 
 def _places(scene: _Scene, obj: HouseObject, p: Placed, lo: np.ndarray, hi: np.ndarray, reach: float,
@@ -585,7 +641,7 @@ def _soft_spot(slot: Slot, p: Placed, lo: np.ndarray, hi: np.ndarray, rng: rando
     step = 0.025 * attempt
     if slot.type == "Pillow":
         along, across = -depth / 2 + d / 2 + 0.03 + step + rng.uniform(0, 0.02), 0.0
-        if slot.spec.lived_in > 1 and width > 1.2:
+        if slot.spec.lived_in > 1 and width > SINGLE_BED:
             across = (-1) ** slot.order * (width / 4 - 0.02) + rng.uniform(-0.02, 0.02)
     elif slot.type == "Duvet":
         along, across = depth / 2 - d / 2 - rng.uniform(0.0, 0.06) - step, 0.0

@@ -23,6 +23,9 @@ PARALLEL_COS = np.cos(np.radians(30.0))
 TIE_DECIMALS = 6
 """Distances are compared at micrometre resolution so ties break by index, not by noise."""
 
+FRONT_CLEARANCE = 0.3
+"""Metres a front that must open (an appliance's door) needs before a wall or a blocker."""
+
 SWAP_RATIO = 1.15
 """How much longer than the other a box axis must be before 'short'/'long' fronts care."""
 
@@ -31,14 +34,20 @@ SHORT_FRONT = frozenset({
     'Bathtub', 'Cabinet', 'Closet', 'Desk', 'Door', 'Dresser', 'Drying', 'Keyboard', 'Laptop', 'Lighter',
     'Microwave', 'Mirror', 'Picture', 'Shelf', 'Sofa', 'Standard', 'Towel', 'Tv', 'Wall', 'Washbasin'})
 LONG_FRONT = frozenset({'Bed', 'Toilet'})
+OPENING_FRONT = frozenset({'Dishwasher', 'Oven', 'Refrigerator', 'WashingMachine'})
+"""Appliances: near-square boxes whose front is a door, so the side it is on is never swapped for a
+better fit of a model's proportions, and it opens into the room (``choose_facing``'s blockers)."""
 
 
 def front_axis(object_type: str) -> str:
-    """Which box side a type's front belongs on: 'short', 'long' or 'any' (see :func:`suits_box`).
+    """Which box side a type's front belongs on: 'short', 'long', 'door' (an appliance's: any side,
+    but the one chosen stays) or 'any' (see :func:`suits_box`).
 
     Pass it to :func:`choose_facing` so that, say, a wardrobe in a corner backs onto the wall
     behind its long side.
     """
+    if object_type in OPENING_FRONT:
+        return 'door'
     return 'short' if object_type in SHORT_FRONT else 'long' if object_type in LONG_FRONT else 'any'
 
 
@@ -47,7 +56,8 @@ def suits_box(front: str, size: Sequence[float] | np.ndarray, facing: int) -> bo
 
     ``front`` is 'short' (the front looks across the box's short horizontal
     axis: wardrobes, sofas, pictures), 'long' (along the long axis: beds,
-    toilets) or 'any'.  Nearly square boxes suit every facing.
+    toilets), 'door' or 'any' (both suit every facing).  Nearly square boxes
+    suit every facing.
     """
     depth, width = (abs(size[0]), abs(size[1])) if facing % 2 == 0 else (abs(size[1]), abs(size[0]))
     if front == 'short':
@@ -58,7 +68,8 @@ def suits_box(front: str, size: Sequence[float] | np.ndarray, facing: int) -> bo
 
 
 def choose_facing(center_xy: Sequence[float], yaw: float, size: Sequence[float],
-                  wall_segments: Sequence[Segment], front: str = 'any') -> int:
+                  wall_segments: Sequence[Segment], front: str = 'any',
+                  blockers: Sequence[Segment] = ()) -> int:
     """Facing index whose front points away from the nearest wall.
 
     For each of the box's four sides, sweep the side outwards along its
@@ -66,10 +77,17 @@ def choose_facing(center_xy: Sequence[float], yaw: float, size: Sequence[float],
     the side with the shortest distance is the back.  ``front`` (see
     ``suits_box``) limits the choice to facings that suit the type, so a
     wardrobe in a corner backs onto the wall behind its long side even when
-    the wall at its end is nearer.  Ties go to the lowest index; with no
+    the wall at its end is nearer.  With ``blockers`` (the edges of what
+    stands beside an appliance), a front with a wall or a blocker closer
+    than FRONT_CLEARANCE is left out where another suitable front is open:
+    a washing machine in a corner beside a sink unit opens into the room,
+    not into the wall or the unit.  Ties go to the lowest index; with no
     wall in reach the facing is the lowest suitable one.
     """
     suitable = [f for f in range(4) if suits_box(front, size, f)]  # never empty
+    if blockers:
+        ahead = side_distances(center_xy, yaw, size, [*wall_segments, *blockers])
+        suitable = [f for f in suitable if ahead[f] >= FRONT_CLEARANCE] or suitable
     distances = side_distances(center_xy, yaw, size, wall_segments)
     backs = [(f + 2) % 4 for f in suitable]
     if not np.isfinite(distances[backs]).any():

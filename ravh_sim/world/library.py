@@ -81,6 +81,7 @@ _KIND_WORDS: tuple[tuple[Kind, str], ...] = (
     ("mirror", r"mirror|miroir"),
     ("screen", r"screen|display|lcd|monitor|ecran"),
     ("glass", r"glass|verre|crystal|transp"),
+    ("ceramic", r"white[-_ ]?metal|paint"),      # painted steel (a washer's body, blind slats): enamel, not bare
     ("metal", r"chrom|metal|steel|inox|alumin|silver|iron|brass|gold|nickel|copper"),
     ("leather", r"leather|cuir"),
     ("fabric", r"fabric|cloth|cushion|textile|velvet|linen|cotton|tissu|sheet|pillow|mattress|blanket|curtain"),

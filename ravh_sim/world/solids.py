@@ -26,7 +26,7 @@ import trimesh
 from shapely.geometry import MultiPoint, Polygon
 
 from ravh_sim.world import library
-from ravh_sim.world.facing import choose_facing, front_axis, suits_box
+from ravh_sim.world.facing import OPENING_FRONT, choose_facing, front_axis, suits_box
 from ravh_sim.world.furniture import build_parts, variant_count
 from ravh_sim.world.house import Door, House, HouseObject
 from ravh_sim.world.mesh import box, merged
@@ -150,7 +150,8 @@ def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
             return Placed((), bounds, box.position, obj.yaw, fitted, obj.yaw)
         variant -= 1
     walls = tuple((w.a, w.b) for w in house.walls if w.room == obj.room and w.kind != "lintel")
-    facing = _facing(tuple(box.position[:2]), obj.yaw, tuple(box.size), walls, front_axis(obj.type))
+    facing = _facing(tuple(box.position[:2]), obj.yaw, tuple(box.size), walls, front_axis(obj.type),
+                     _blockers(house, obj))
     records = library.models_of(library.kind_of(obj.type, obj.prefab))
     if records:
         record, facing = _library_choice(records, variant, np.asarray(box.size), facing, front_axis(obj.type))
@@ -260,6 +261,27 @@ def _piece_bounds(vertices: np.ndarray, faces: np.ndarray, labels: np.ndarray) -
 
 @functools.lru_cache(maxsize=8192)
 def _facing(center: tuple[float, float], yaw: float, size: tuple[float, float, float],
-            walls: tuple, front: str) -> int:
+            walls: tuple, front: str, blockers: tuple) -> int:
     """Cached :func:`choose_facing`: every free-space map asks again for every object."""
-    return choose_facing(center, yaw, size, walls, front=front)
+    return choose_facing(center, yaw, size, walls, front=front, blockers=blockers)
+
+
+STANDING_HEIGHT_M = 0.5          # a neighbour this tall, standing on the floor, blocks a door in front of it
+
+
+def _blockers(house: House, obj: HouseObject) -> tuple:
+    """The edges of the house's boxes of what stands on the floor in an appliance's room (kitchen
+    units, a washbasin's cabinet, another appliance); nothing for other types."""
+    if obj.type not in OPENING_FRONT:
+        return ()
+    edges = []
+    for other in house.objects:
+        x, y, z = other.position
+        w, d, h = other.size
+        if other is obj or other.room != obj.room or h < STANDING_HEIGHT_M or z - h / 2 > 0.1:
+            continue
+        c, s = math.cos(other.yaw), math.sin(other.yaw)
+        corners = [(x + c * u - s * v, y + s * u + c * v) for u, v in
+                   ((w / 2, d / 2), (-w / 2, d / 2), (-w / 2, -d / 2), (w / 2, -d / 2))]
+        edges += [(corners[k], corners[(k + 1) % 4]) for k in range(4)]
+    return tuple(edges)
