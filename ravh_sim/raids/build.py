@@ -35,7 +35,14 @@ from ravh_sim.dataset import layout
 from ravh_sim.errors import UserError
 from ravh_sim.paper import RAID_COLUMNS, TABLE2, table2
 from ravh_sim.raids.outcome import Outcome
-from ravh_sim.raids.raid import PRESETS, QUALITY_PROFILES, RAID_QUALITY_HELP, preset_settings, run_raid
+from ravh_sim.raids.raid import (
+    PRESETS,
+    QUALITY_PROFILES,
+    RAID_QUALITY_HELP,
+    preset_settings,
+    quality_profile,
+    run_raid,
+)
 
 ENGINES = ("direct", "ros")
 POLL_S = 0.5
@@ -196,8 +203,7 @@ def build(root: Path, houses: list[int], raids: list[int], workers: int = 1, eng
         raise UserError(f"--engine: unknown engine {engine!r}; valid: {', '.join(ENGINES)}")
     if workers < 1:
         raise UserError(f"--workers must be >= 1, got {workers}")
-    if quality not in QUALITY_PROFILES:
-        raise UserError(f"--quality: unknown quality {quality!r}; valid: {', '.join(QUALITY_PROFILES)}")
+    quality_profile(quality)                  # an unknown quality fails here, before any raid runs
     root.mkdir(parents=True, exist_ok=True)
     jobs = [Job(h, r, raid_seed(h, r, seed)) for h in houses for r in raids]
     options = BuildOptions(engine, max_captures, max_nodes, quality)

@@ -11,7 +11,6 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 import cv2
 import numpy as np
@@ -116,11 +115,12 @@ def dressing_gallery(house_number: int, output: Path, seed: int = 0,
     return _write(np.vstack(rows), output)
 
 
-def _best_view(world: World, renderer: str, *how: Any) -> tuple[float, float, float]:
-    """:func:`best_view` (``how``: its options) counted on a fast render."""
+def _best_view(world: World, renderer: str, kinds: tuple[str, ...] = ("object",),
+               stand_back: bool = False) -> tuple[float, float, float]:
+    """:func:`best_view` counted on a fast render."""
     scout = SmartCamera(world, replace(load_profile().camera, quality="fast"), backend=renderer)
     try:
-        return best_view(world, scout, *how)
+        return best_view(world, scout, kinds, stand_back)
     finally:
         scout.close()
 

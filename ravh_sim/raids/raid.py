@@ -72,14 +72,19 @@ PRESETS = (
 def preset_settings(preset: RaidPreset, seed: int, quality: str = "realistic") -> dict:
     """The settings file of a raid preset (keys as in config/default.yaml); ``quality`` (a key of
     QUALITY_PROFILES) picks the robot profile, so the footprint records which camera made the raid."""
-    if quality not in QUALITY_PROFILES:
-        raise UserError(f"unknown raid quality {quality!r}; valid: {', '.join(QUALITY_PROFILES)}")
     return {"seed": seed,
             "lights": {"sun_angle": preset.sun, "ceiling": preset.ceiling, "lamps": preset.lamps},
             "paint": {"walls": preset.paint, "floors": preset.paint},
             "models": {"all": preset.models},
             "dressing": "none",          # the paper's raids: the paper's objects, nothing else
-            "agents": [{"name": DEFAULT_AGENT, "profile": QUALITY_PROFILES[quality]}]}
+            "agents": [{"name": DEFAULT_AGENT, "profile": quality_profile(quality)}]}
+
+
+def quality_profile(quality: str) -> str:
+    """The robot profile of a raid's camera quality (QUALITY_PROFILES); an unknown one is a UserError."""
+    if quality not in QUALITY_PROFILES:
+        raise UserError(f"unknown raid quality {quality!r}; valid: {', '.join(QUALITY_PROFILES)}")
+    return QUALITY_PROFILES[quality]
 
 
 def run_raid(house: int | str, raid: int, out: Path, fast: bool = False, seed: int | None = None,

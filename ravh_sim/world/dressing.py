@@ -37,7 +37,7 @@ from __future__ import annotations
 import functools
 import math
 import random
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -170,13 +170,23 @@ class Dressed:
 
     def placed(self) -> Placed:
         """The fitted model in its body frame and the body's pose, as :mod:`ravh_sim.world.solids` has it."""
-        if soft_furnishings.is_soft(self.slot.model_id) or made_objects.is_made(self.slot.model_id):
-            made = soft_furnishings.model if soft_furnishings.is_soft(self.slot.model_id) else made_objects.model
+        made = _made_here(self.slot.model_id)
+        if made is not None:
             fitted = made(self.slot.model_id, self.slot.size)
             bounds = _piece_bounds(fitted.vertices, fitted.faces, fitted.face_attributes["piece"])
         else:
             fitted, bounds = _fitted(self.slot.model_id, self.slot.size, 0)
         return Placed((), bounds, self.position, self.yaw, fitted, self.yaw)
+
+
+def _made_here(model_id: str) -> Callable[[str, tuple[float, float, float]], trimesh.Trimesh] | None:
+    """The builder of a model made here to its box (soft furnishings, books, dish racks); None for a
+    library model."""
+    if soft_furnishings.is_soft(model_id):
+        return soft_furnishings.model
+    if made_objects.is_made(model_id):
+        return made_objects.model
+    return None
 
 
 def kind_models(spec: Spec) -> tuple[library.LibraryRecord, ...]:
@@ -353,7 +363,7 @@ def _box(house: House, support: str, spec: Spec) -> tuple[float, float, float]:
 def _size(model_id: str, spec: Spec, box_size: tuple[float, float, float]) -> tuple[float, float, float]:
     """The model's box when scaled into ``box_size``: uniformly (keeping its proportions), or as the
     library fits furniture where the spec stretches (a duvet to a bed, a curtain to a window)."""
-    if soft_furnishings.is_soft(model_id) or made_objects.is_made(model_id):          # made to measure
+    if _made_here(model_id) is not None:          # made to measure
         return tuple(round(float(v), 4) for v in box_size)      # type: ignore[return-value]
     natural = np.maximum(np.ptp(library.load_model(model_id).vertices, axis=0), 1e-4)
     box = np.asarray(box_size, np.float64)

@@ -28,6 +28,7 @@ from shapely.geometry import MultiPoint, Polygon
 from ravh_sim.world import library
 from ravh_sim.world.facing import OPENING_FRONT, choose_facing, front_axis, suits_box
 from ravh_sim.world.furniture import build_parts, variant_count
+from ravh_sim.world.geometry import box_corners
 from ravh_sim.world.house import Door, House, HouseObject
 from ravh_sim.world.mesh import box, merged
 from ravh_sim.world.palette import PALETTE
@@ -280,8 +281,6 @@ def _blockers(house: House, obj: HouseObject) -> tuple:
         w, d, h = other.size
         if other is obj or other.room != obj.room or h < STANDING_HEIGHT_M or z - h / 2 > 0.1:
             continue
-        c, s = math.cos(other.yaw), math.sin(other.yaw)
-        corners = [(x + c * u - s * v, y + s * u + c * v) for u, v in
-                   ((w / 2, d / 2), (-w / 2, d / 2), (-w / 2, -d / 2), (w / 2, -d / 2))]
+        corners = [(float(cx), float(cy)) for cx, cy in box_corners((x, y), (w, d), other.yaw)]
         edges += [(corners[k], corners[(k + 1) % 4]) for k in range(4)]
     return tuple(edges)
