@@ -306,6 +306,23 @@ def misfit(natural: np.ndarray, size: np.ndarray) -> float:
     return float(ratio.max() - ratio.min())
 
 
+
+def made_to_box(vertices: np.ndarray, size: tuple[float, float, float]) -> np.ndarray:
+    """A shape made here, moved and scaled to fill a box of ``size`` centred on the origin exactly, as
+    :func:`fit` sets a library model (soft furnishings, books, dish racks)."""
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    return (vertices - (lo + hi) / 2) / np.maximum(hi - lo, 1e-9) * np.asarray(size, np.float64)
+
+
+def made_model(fitted: np.ndarray, faces: np.ndarray, uv: np.ndarray, record: LibraryRecord,
+               material: np.ndarray, piece: np.ndarray) -> trimesh.Trimesh:
+    """A model made here in a library model's form: its ``record`` (with its triangle count) in
+    ``metadata``, a ``material`` and ``piece`` per face, texture coordinates."""
+    return trimesh.Trimesh(fitted, faces, process=False, visual=uv_visual(uv.astype(np.float32)),
+                           face_attributes={"material": material, "piece": piece},
+                           metadata={"record": record.model_copy(update={"triangles": len(faces)})})
+
+
 def fit(model: trimesh.Trimesh, size: np.ndarray) -> np.ndarray:
     """The model's vertices scaled into a box of ``size`` (front, across, up) centred at the origin
     (:func:`fit_scale`), standing on the box's floor with its back against the box's back

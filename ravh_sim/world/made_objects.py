@@ -25,8 +25,8 @@ import random
 import numpy as np
 import trimesh
 
+from ravh_sim.poses import rotation_y, rotation_z
 from ravh_sim.world import library
-from ravh_sim.world.mesh import uv_visual
 
 KINDS = ("book", "dish_rack")
 VARIANTS = {"book": 8, "dish_rack": 4}
@@ -128,19 +128,9 @@ class _Parts:
         self.prism(np.array([(x0, y0), (x1, y0), (x1, y1), (x0, y1)]), z0, z1, material)
 
 
-def _turn_z(angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
 def _turn_x(angle: float) -> np.ndarray:
     c, s = math.cos(angle), math.sin(angle)
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
-def _turn_y(angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 SPINE = 0.005                 # m: how far a spine's rounding bulges
@@ -206,7 +196,7 @@ def _book_stack(parts: _Parts, size: np.ndarray, rng: random.Random) -> None:
         shrink = min(1.0, d / (c * bd + s * bw), w / (s * bd + c * bw))   # turned, still inside the box
         bd, bw = bd * shrink, bw * shrink
         # lying: the book's thickness (its y) up, its height (its z) across, centred, then turned
-        lying = _turn_z(turn) @ _turn_x(math.pi / 2)
+        lying = rotation_z(turn) @ _turn_x(math.pi / 2)
         middle = lying @ np.array([0.0, 0.0, bw / 2])
         _book(parts, bd, float(t), bw, 1 + rng.randrange(_COVERS_A_MODEL), lying,
               (-middle[0], -middle[1], z + float(t) / 2))
@@ -240,7 +230,8 @@ def _dish_rack(parts: _Parts, size: np.ndarray, rng: random.Random) -> None:
     for x in np.linspace(-d / 2 + 0.06, d / 2 - 0.07, 5)[:count]:   # a disc in the y-z plane, tipped back
         lowest = diameter / 2 * math.cos(lean) + plate_t / 2 * math.sin(lean)      # its centre above its rim
         parts.prism(_circle(14) * diameter / 2, -plate_t / 2, plate_t / 2, 1,
-                    turn=_turn_y(-lean) @ _turn_y(math.pi / 2), shift=(float(x), centre_y, bottom + base + lowest))
+                    turn=rotation_y(-lean) @ rotation_y(math.pi / 2),
+                    shift=(float(x), centre_y, bottom + base + lowest))
     cup_d, cup_h = min(0.085, w - diameter - 3 * wall), 0.095
     for k in range(rng.randrange(1, 3)):
         parts.prism(_circle(12) * cup_d / 2, bottom + base, bottom + base + cup_h, 2,
@@ -261,14 +252,8 @@ def model(model_id: str, size: tuple[float, float, float]) -> trimesh.Trimesh:
         _book_row(parts, box, rng)
     else:
         _book_stack(parts, box, rng)
-    vertices = np.vstack(parts.vertices)
-    faces = np.vstack(parts.faces)
-    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
-    fitted = (vertices - (lo + hi) / 2) / np.maximum(hi - lo, 1e-9) * box    # exactly its box (a few mm off)
+    fitted = library.made_to_box(np.vstack(parts.vertices), size)    # exactly its box (a few mm off)
     entry = _record(kind, int(variant), tuple(float(s) for s in box))   # type: ignore[arg-type]
-    entry = entry.model_copy(update={"triangles": len(faces)})
     uv = np.stack([fitted[:, 1] + fitted[:, 0], fitted[:, 2] + fitted[:, 0]], axis=1)
-    return trimesh.Trimesh(fitted, faces, process=False, visual=uv_visual(uv.astype(np.float32)),
-                           face_attributes={"material": np.concatenate(parts.materials),
-                                            "piece": np.concatenate(parts.pieces)},
-                           metadata={"record": entry})
+    return library.made_model(fitted, np.vstack(parts.faces), uv, entry, np.concatenate(parts.materials),
+                              np.concatenate(parts.pieces))

@@ -28,7 +28,6 @@ import numpy as np
 import trimesh
 
 from ravh_sim.world import library
-from ravh_sim.world.mesh import uv_visual
 
 KINDS = ("pillow", "duvet", "cushion", "throw")
 VARIANTS = 8
@@ -148,12 +147,7 @@ def model(model_id: str, size: tuple[float, float, float]) -> trimesh.Trimesh:
     centred on it, as :func:`ravh_sim.world.library.fit` sets a library model."""
     kind, variant = model_id.removeprefix(PREFIX).split("/")
     vertices, faces, uv = _shape(kind, int(variant))
-    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
     box = np.asarray(size, np.float64)
-    fitted = (vertices - (lo + hi) / 2) / np.maximum(hi - lo, 1e-9) * box
     entry = _record(kind, int(variant), tuple(float(s) for s in box))   # type: ignore[arg-type]
-    entry = entry.model_copy(update={"triangles": len(faces)})
-    return trimesh.Trimesh(fitted, faces, process=False, visual=uv_visual((uv * box[:2].max()).astype(np.float32)),
-                           face_attributes={"material": np.zeros(len(faces), np.int64),
-                                            "piece": np.zeros(len(faces), np.int64)},
-                           metadata={"record": entry})
+    single = np.zeros(len(faces), np.int64)                             # one fabric, one piece
+    return library.made_model(library.made_to_box(vertices, size), faces, uv * box[:2].max(), entry, single, single)
