@@ -100,10 +100,11 @@ def test_degraded_detections_score_what_they_should(exported):
     gt = COCO(str(root / "coco" / "instances.json"))
     ours = _our_detections(root, ds, gt)
     # boxes half as wide, inside their object's: IoU exactly 1/2, a hit at IoU 0.5 and a miss from 0.55 on
-    # (twice as wide: the same IoU, but reaches into neighbours: one matches the kitchen unit beside it at 0.55)
+    # (twice as wide: the same IoU, but reaches into neighbours: one matches the kitchen unit beside it at 0.55);
+    # AP and AP50 within 1 % of 0.1 and 1: a half box may take a neighbour of its class (chairs side by side)
     narrow = [{**d, "bbox": [d["bbox"][0], d["bbox"][1], d["bbox"][2] / 2, d["bbox"][3]]} for d in ours]
     ap, ap50, ap75 = _scores(gt, narrow, "bbox")[:3]
-    assert (ap, ap50, ap75) == (pytest.approx(0.1), pytest.approx(1.0), pytest.approx(0.0))
+    assert (ap, ap50, ap75) == (pytest.approx(0.1, rel=0.01), pytest.approx(1.0, rel=0.01), pytest.approx(0.0))
     # every other category left out: those categories score 0, the rest 1
     categories = sorted({d["category_id"] for d in ours})
     kept = set(categories[::2])

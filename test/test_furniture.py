@@ -27,7 +27,7 @@ from ravh_sim.world.palette import PALETTE, Palette
 # Upstream Robot@VirtualHome model counts per type (from the house data).
 UPSTREAM_MODELS = {
     'Counter': 4, 'Door': 3, 'Keyboard': 1, 'Lighter': 1, 'Mirror': 2, 'Picture': 4, 'Pouf': 4, 'Station': 1,
-    'Toothbrush': 1, 'Wall': 3,
+    'Toothbrush': 1, 'Wall': 3, 'Shelf': 3, 'Brush': 1,
 }
 
 # Typical upstream box sizes (sx, sy, sz) in metres; other types use a generic 0.6 m box.
@@ -35,6 +35,7 @@ TYPICAL = {
     'Counter': (0.6, 0.58, 0.04), 'Door': (0.26, 0.94, 2.5), 'Mirror': (0.68, 0.04, 1.05),
     'Picture': (0.68, 0.04, 0.48), 'Wall': (1.36, 0.17, 1.36), 'Station': (0.5, 0.5, 0.02),
     'Keyboard': (0.44, 0.14, 0.03), 'Toothbrush': (0.06, 0.11, 0.2), 'Pouf': (0.5, 0.5, 0.4),
+    'Shelf': (0.67, 0.24, 0.04), 'Brush': (0.17, 0.17, 0.44),
 }
 
 

@@ -126,28 +126,31 @@ def test_laser_endpoints_land_on_the_map_edges(number):
 
 def test_the_map_is_the_cut_at_laser_height(houses):
     """Objects wholly below the laser plane are free on /map but blocked in the robot's free space; an
-    object the plane cuts is on /map only where its parts are (between a chair's legs is free)."""
-    house = houses[15]
-    settings = resolved(house)
-    nav = Navigation(house, WorldState(settings), load_profile("giraff"))
-    grid, free_space, height = nav.obstacle_map(), nav.map(), nav.profile.laser.height
+    object the plane cuts is on /map only where its parts are (between a chair's legs is free). Houses 15
+    (its chairs) and 7 (a pouf 20 cm high)."""
     below = cut = 0
-    for obj in house.objects:
-        if obj.type in ("Door", "Wall", "Light", "Station"):
-            continue
-        placed = object_parts(house, obj, settings.models.get(obj.id))
-        (x, y), floor = placed.position[:2], house.room(obj.room).floor_z
-        top = placed.position[2] + placed.extent()[1][2]
-        if top < floor + height - 0.01:
-            assert grid.data[grid.cell_of(x, y)] == FREE and free_space.data[free_space.cell_of(x, y)] == OCCUPIED
-            below += 1
-        elif obj.type == "Chair":
-            mask = np.zeros(grid.shape, np.uint8)
-            _draw_section(mask, placed.section(floor + height), grid)
-            r, c = grid.cell_of(x, y)
-            if not mask[r, c]:
-                assert grid.data[r, c] == FREE          # the middle of a chair, between its legs
-                cut += 1
+    for number in (15, 7):
+        house = houses[number]
+        settings = resolved(house)
+        nav = Navigation(house, WorldState(settings), load_profile("giraff"))
+        grid, free_space, height = nav.obstacle_map(), nav.map(), nav.profile.laser.height
+        for obj in house.objects:
+            if obj.type in ("Door", "Wall", "Light", "Station"):
+                continue
+            placed = object_parts(house, obj, settings.models.get(obj.id))
+            (x, y), floor = placed.position[:2], house.room(obj.room).floor_z
+            top = placed.position[2] + placed.extent()[1][2]
+            if top < floor + height - 0.01:
+                assert grid.data[grid.cell_of(x, y)] == FREE
+                assert free_space.data[free_space.cell_of(x, y)] == OCCUPIED
+                below += 1
+            elif obj.type == "Chair" and number == 15:     # house 7's stand under a table that covers them
+                mask = np.zeros(grid.shape, np.uint8)
+                _draw_section(mask, placed.section(floor + height), grid)
+                r, c = grid.cell_of(x, y)
+                if not mask[r, c]:
+                    assert grid.data[r, c] == FREE          # the middle of a chair, between its legs
+                    cut += 1
     assert below >= 1 and cut >= 1
 
 

@@ -51,13 +51,18 @@ covered shading quads, and pybullet builds a collider of each, so house 15 went 
 MIN_TRIANGLES = 150
 OVER_BUDGET = 1.5
 ABSOLUTE_BUDGET = 1500
-"""A model that simplification cannot bring within OVER_BUDGET times its budget, nor under
-ABSOLUTE_BUDGET (thousands of loose pieces), is passed over for the kind's next match; a kind whose
-every match is over keeps its smallest."""
+"""A model that simplification cannot bring within OVER_BUDGET times its budget (keeping AREA_KEPT of its
+surface), nor under ABSOLUTE_BUDGET (thousands of loose pieces), is passed over for the kind's next
+match; a kind whose every match is over keeps its smallest."""
 APPLIANCE_TRIANGLES = 2500
 """Triangles of an appliance, sink or washbasin whatever its size (see :data:`APPLIANCES`): a house has a
 handful, in one kitchen and its bathrooms, and what names them is small detail (handles, a display, an
 oven window, knobs, taps) that 1,000 triangles decimate away; the catalogues' best ones keep 2,500-3,600."""
+OVEN_TRIANGLES = 3500
+OVEN_ALLOWED = 6000
+"""An oven's budget and the most triangles it may keep (``Rule.allowed``): the built-in oven keeps its
+window and racks at 5,600 (simplified towards 3,500, then AREA_KEPT); at APPLIANCE_TRIANGLES its window
+went, or it was passed over, leaving a small oven that reads as a space heater. A kitchen has one."""
 TABLEWARE_TRIANGLES = 400
 """Least triangles of a small dressing object (tableware, kettles, pans, bottles, plants): at
 MIN_TRIANGLES a pan became a cone and a teapot a box; they are seen close up on tables and worktops."""
@@ -78,6 +83,19 @@ live model's triangles (otherwise the live model is the dataset level too)."""
 DATASET_TEXELS = 1024
 """Longest side of a dataset-level texture (``textures/full/<live name>.jpg``, written only where the
 catalogue's texture is larger than TEXTURE_TEXELS)."""
+AREA_KEPT = 0.7
+"""Share of a material's surface its simplified mesh keeps (:func:`_decimate`): below it decimation
+has eaten whole panels (a vase's body, a table's top), not detail."""
+FOLIAGE_AREA_KEPT = 0.5
+"""AREA_KEPT of a plant's leaves (``Rule.foliage``): decimation thins leaves rather than breaking
+panels, and a plant keeping 70 % of its thousands of leaves would be past any budget."""
+WHOLE_PIECE = 48
+"""Triangles of a piece simplification keeps whole (:func:`_whole_pieces`): boxes, panels, a bevelled slab."""
+AREA_ATTEMPTS = 3
+"""Tries at AREA_KEPT, the share doubling after each (at most 4x the material's share)."""
+WHOLE_MATERIAL = 600
+"""Triangles of a material left whole where AREA_ATTEMPTS tries still lose its surface (a bed's drawer
+panel, a small share of a large model's budget); a larger one keeps its last try."""
 MAX_PER_TYPE = 4
 DROPPED_OPACITY = CLEAR_GLASS_OPACITY
 """Materials at most this opaque (clear glass panes) are left out: no sensor of ours sees them (the
@@ -93,7 +111,9 @@ class Rule:
     ``skip_ids`` passes over entries whose name matches but whose model does not look the part (an oven
     that reads as a microwave); ``least``/``most`` bound the kind's triangle budget (default
     MIN_TRIANGLES / TRIANGLE_BUDGET, read when used); ``dataset``: its models get a finer dataset level
-    (DATASET_FACTOR)."""
+    (DATASET_FACTOR); ``foliage``: its models are mostly leaves, which decimation thins rather than
+    breaks, so their simplification keeps no share of the surface (AREA_KEPT): a plant's thousands of
+    leaves would take it past any budget."""
     name: str
     categories: tuple[str, ...] = INDOOR
     exclude: str = r"$^"
@@ -102,6 +122,8 @@ class Rule:
     least: int | None = None
     most: int | None = None
     dataset: bool = False               # a finer dataset level (DATASET_FACTOR) is written for its models
+    foliage: bool = False
+    allowed: int | None = None          # most triangles a model may keep (default: see ABSOLUTE_BUDGET)
 
 
 def triangle_budget(rule: Rule, longest_m: float) -> int:
@@ -112,34 +134,44 @@ def triangle_budget(rule: Rule, longest_m: float) -> int:
     return int(np.clip(TRIANGLE_BUDGET * longest_m / 1.5, least, max(least, most)))
 
 
-def _appliance(name: str, categories: tuple[str, ...] = INDOOR, ids: str = r"$^", skip_ids: str = r"$^") -> Rule:
-    return Rule(name, categories, ids=ids, skip_ids=skip_ids, least=APPLIANCE_TRIANGLES, most=APPLIANCE_TRIANGLES,
-                dataset=True)
+def allowed_triangles(rule: Rule, budget: int) -> float:
+    """Most triangles a model of ``rule``'s kind may keep, simplified towards ``budget``."""
+    return rule.allowed if rule.allowed is not None else max(OVER_BUDGET * budget, ABSOLUTE_BUDGET)
+
+
+def _appliance(name: str, categories: tuple[str, ...] = INDOOR, ids: str = r"$^", skip_ids: str = r"$^",
+               triangles: int = APPLIANCE_TRIANGLES, allowed: int | None = None) -> Rule:
+    return Rule(name, categories, ids=ids, skip_ids=skip_ids, least=triangles, most=triangles, dataset=True,
+                allowed=allowed)
 
 
 def _tableware(name: str, ids: str = r"$^", skip_ids: str = r"$^") -> Rule:
     return Rule(name, ids=ids, skip_ids=skip_ids, least=TABLEWARE_TRIANGLES)
 
 
+HOLLOW = r"#kitchenDrawersCabinet$"
+"""Drawer fronts with nothing behind them: the laser passes the 1 cm gaps between the drawers, which
+no camera pixel resolves, and reads the cabinet as not there."""
+
 RULES: dict[str, Rule] = {
     "Armchair": Rule(r"armchair$|^armchair", exclude=r"ottoman|rattan|office"),
     "Bathtub": Rule(r"^bath$|bathtub|^fitted bath|^island bath"),
     "Bed": Rule(r"^bed\b|^double bed|^iron bed|^captain's bed", ("Bedroom",),
                 exclude=r"side|bunk|loft|child|baby|sofa"),
-    "Brush": Rule(r"^toilet brush$|^brush$", ("Bathroom",)),
     "Burner": _appliance(r"cooktop|induction cooker|^hob|^stove$"),
     "Cabinet": Rule(r"^cupboard$|glass door cabinet|^chest$|filing cabinet", exclude=r"kitchen"),
-    "Chair": Rule(r"^chair$|^oak chair$|chair with cushion|^osaka chair", ("Living room", "Kitchen")),
+    "Chair": Rule(r"^chair$|^oak chair$|chair with cushion|^osaka chair", ("Living room", "Kitchen"),
+                  skip_ids=r"#antiqueChair$|^Blend Swap CC-0#chair2$"),  # baroque and banquet chairs: no home's
     "Chair/office": Rule(r"chair|armchair", ("Office",), exclude=r"class|child"),
     "Closet": Rule(r"^wardrobe$"),
     "Cup": Rule(r"^coffee cup$|^coffee mug$|^cup$"),
-    "Decoration": Rule(r"^plant$|little plant|indoor plant|yucca|succulent|spider plant|cactus"),
+    "Decoration": Rule(r"^plant$|little plant|indoor plant|yucca|succulent|spider plant|cactus", foliage=True),
     "Decoration/vase": Rule(r"^vase$"),
     "Desk": Rule(r"^desk$|wooden desk|^desk table"),
     "Dishwasher": _appliance(r"dishwasher"),
-    "Dresser": Rule(r"^dresser|chest of drawers|drawers cabinet|^chest$", exclude=r"kitchen"),
+    "Dresser": Rule(r"^dresser|chest of drawers|drawers cabinet|^chest$", exclude=r"kitchen", skip_ids=HOLLOW),
     "Drying": Rule(r"towel rack|radiator"),
-    "KitchenFurniture": Rule(r"^lower cabinet$|^kitchen cabinet$|^drawers cabinet$", ("Kitchen",)),
+    "KitchenFurniture": Rule(r"^lower cabinet$|^kitchen cabinet$|^drawers cabinet$", ("Kitchen",), skip_ids=HOLLOW),
     "KitchenFurniture/upper": Rule(r"upper cabinet", ("Kitchen",), exclude=r"corner|shelves"),
     "KitchenFurniture/corner": Rule(r"lower corner cabinet|^lower cabinet$|^kitchen cabinet$", ("Kitchen",)),
     "KitchenFurniture/corner_upper": Rule(r"upper corner cabinet|upper cabinet", ("Kitchen",)),
@@ -151,9 +183,9 @@ RULES: dict[str, Rule] = {
     "Light": Rule(r"ceiling lamp|pendant lamp|hanging light", ("Lights",)),
     "Microwave": Rule(r"microwave"),     # the catalogues' one, over any budget: kept as it was
     "Nightstand": Rule(r"bedside table|night ?stand|night table"),
-    "Oven": _appliance(r"^oven$|^small oven$", skip_ids=r"^eTeks#oven$"),  # a bare box: read as a microwave
+    "Oven": _appliance(r"^oven$|^small oven$", skip_ids=r"^eTeks#oven$",  # a bare box: read as a microwave
+                       triangles=OVEN_TRIANGLES, allowed=OVEN_ALLOWED),
     "Refrigerator": _appliance(r"fridge|refrigerator", skip_ids=r"^eTeks#fridge"),  # plain boxes: "wardrobe"
-    "Shelf": Rule(r"^shelves$|^vertical shelves$|wall shelf"),
     "ShowerCabin": Rule(r"^shower$|shower stall|shower cabin"),
     "Sink": _appliance(r"^small lavatory$", ids=r"^Scopia#bathroom4$"),   # a bowl with taps, not a cabinet
     "Sofa": Rule(r"^sofa|^couch$|winchester sofa|burlap sofa|clear sofa|^futon couch",
@@ -179,9 +211,10 @@ RULES: dict[str, Rule] = {
     "Dressing/kettle": _tableware(r"espresso kettle|^teapot$"),            # the kettle ("boiler") to a diamond
     "Dressing/bottle": _tableware(r"wine bottle|beer bottle|oil servers"),
     "Dressing/box": _tableware(r"cardboard box$|^gift$"),
-    "Dressing/plant": _tableware(r"^little plant$|^succulent plant$|^bamboo$|^cactus$"),
+    "Dressing/plant": Rule(r"^little plant$|^succulent plant$|^bamboo$|^cactus$", least=TABLEWARE_TRIANGLES,
+                           foliage=True),
     "Dressing/floor_plant": Rule(r"^yucca$|^ficus$|^decorative plant$|^spathiphyllum$",
-                                 ids=r"^Scopia#maceta$|^Blend Swap CC-0#plant$"),
+                                 ids=r"^Scopia#maceta$|^Blend Swap CC-0#plant$", foliage=True),
     "Dressing/towel": Rule(r"^towel$"),
     "Dressing/rug": Rule(r"oriental rug|round carpet|^bathmat$|^doormat$"),
     "Dressing/curtain": Rule(r"^curtains?$"),
@@ -389,14 +422,15 @@ def convert(entry: Entry, zf: zipfile.ZipFile, rule: Rule = Rule("")) -> Convert
     vertices = (vertices - (lo + hi) / 2) * (target / np.maximum(hi - lo, 1e-9))
     budget = triangle_budget(rule, float(target.max()))
     full_faces, full_material = faces, face_material
-    mesh, uvs, face_material = _simplify(vertices, obj.uvs, faces, face_material, budget)
+    area_kept = FOLIAGE_AREA_KEPT if rule.foliage else AREA_KEPT
+    mesh, uvs, face_material = _simplify(vertices, obj.uvs, faces, face_material, budget, area_kept)
     materials, textures = _materials(obj.materials, np.unique(face_material))
     remap = {old: new for new, old in enumerate(np.unique(face_material))}
     full = None
     if rule.dataset and len(full_faces) >= DATASET_MIN_GAIN * len(mesh.faces):
         known = np.isin(full_material, list(remap))      # a material the live level lost is left out of both
         full_mesh, full_uvs, full_used = _simplify(vertices, obj.uvs, full_faces[known], full_material[known],
-                                                   min(DATASET_FACTOR * budget, DATASET_MAX_TRIANGLES))
+                                                   min(DATASET_FACTOR * budget, DATASET_MAX_TRIANGLES), area_kept)
         if len(full_mesh.faces) >= DATASET_MIN_GAIN * len(mesh.faces):
             full = (full_mesh, full_uvs, np.array([remap[m] for m in full_used], np.uint8))
     return Converted(mesh, uvs, np.array([remap[m] for m in face_material], np.uint8), materials, textures,
@@ -404,10 +438,9 @@ def convert(entry: Entry, zf: zipfile.ZipFile, rule: Rule = Rule("")) -> Convert
 
 
 def _simplify(vertices: np.ndarray, uvs: np.ndarray, faces: np.ndarray, face_material: np.ndarray,
-              budget: int) -> tuple[trimesh.Trimesh, np.ndarray, np.ndarray]:
-    """Each material's triangles simplified to its share of the budget (quadric decimation keeps the
-    silhouette); a kept vertex takes the texture coordinate of an original vertex it absorbed."""
-    import fast_simplification  # the maintainer's tool's own dependency
+              budget: int, area_kept: float = AREA_KEPT) -> tuple[trimesh.Trimesh, np.ndarray, np.ndarray]:
+    """Each material's triangles simplified to its share of the budget: its small pieces whole
+    (:func:`_whole_pieces`), the rest keeping ``area_kept`` of its surface (:func:`_decimate`)."""
     total = len(faces)
     chunks = []
     for material in np.unique(face_material):
@@ -416,13 +449,12 @@ def _simplify(vertices: np.ndarray, uvs: np.ndarray, faces: np.ndarray, face_mat
         points, tris, uv = vertices[used], local.reshape(-1, 3), uvs[used]
         share = max(12, int(budget * len(sub) / max(total, 1)))
         if len(tris) > share and len(tris) > 24:
-            points, tris, collapses = fast_simplification.simplify(
-                points.astype(np.float32), tris.astype(np.int32), 1.0 - share / len(tris), return_collapses=True)
-            _, _, mapping = fast_simplification.replay_simplification(
-                vertices[used].astype(np.float32), local.reshape(-1, 3).astype(np.int32), collapses)
-            new_uv = np.zeros((len(points), 2))
-            new_uv[mapping[::-1]] = uv[::-1]              # some original vertex of each kept one
-            uv = new_uv
+            whole = _whole_pieces(points, tris, share)
+            kept_points, kept_uv, kept_tris = _decimate(points, uv, tris[~whole], share - int(whole.sum()), area_kept)
+            joined = np.concatenate([tris[whole], kept_tris + len(points)])
+            used, corner = np.unique(joined, return_inverse=True)
+            points, uv = np.concatenate([points, kept_points])[used], np.concatenate([uv, kept_uv])[used]
+            tris = corner.reshape(-1, 3)
         chunks.append((np.asarray(points, np.float64), np.asarray(tris, np.int64), uv, material))
     offsets = np.cumsum([0] + [len(c[0]) for c in chunks[:-1]])
     mesh = trimesh.Trimesh(np.concatenate([c[0] for c in chunks]),
@@ -432,6 +464,95 @@ def _simplify(vertices: np.ndarray, uvs: np.ndarray, faces: np.ndarray, face_mat
     valid = mesh.nondegenerate_faces()
     mesh.update_faces(valid)
     return mesh, uv_all, material_all[valid]
+
+
+def _whole_pieces(points: np.ndarray, tris: np.ndarray, share: int) -> np.ndarray:
+    """Per triangle, whether it belongs to a small piece kept whole: pieces of at most WHOLE_PIECE
+    triangles, the largest in area first, up to half the material's ``share``. Quadric decimation
+    collapses such a piece (a table's top is a box of 12 triangles) for less than the cost of thinning
+    a curved part, and then the piece is gone, not coarser."""
+    pieces = piece_labels(points, tris)
+    corners = points[tris]
+    area = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+    counts = np.bincount(pieces)
+    small = np.flatnonzero(counts <= WHOLE_PIECE)
+    small = small[np.argsort(-np.bincount(pieces, weights=area)[small], kind="stable")]
+    chosen = small[np.cumsum(counts[small]) <= share // 2]
+    return np.isin(pieces, chosen)
+
+
+def _decimate(points: np.ndarray, uv: np.ndarray, tris: np.ndarray, share: int, area_kept: float
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One material's mesh simplified towards ``share`` triangles by quadric decimation, keeping
+    ``area_kept`` of its surface where AREA_ATTEMPTS doublings of the share can (else whole, up to
+    WHOLE_MATERIAL triangles).
+
+    The decimation sees the mesh welded by position: an OBJ splits its vertices at every hard edge,
+    so a box's faces are loose quads, and a loose flat quad collapses at no cost; unwelded, a
+    table lost its top and a cabinet its sides. Each kept vertex is then put back on an original
+    vertex it absorbed (the nearest), so a flat top stays flat, and each kept corner takes the
+    texture coordinate of the absorbed vertex on its own side of a hard edge
+    (:func:`_corner_sources`), so texture seams stay seams."""
+    import fast_simplification  # the maintainer's tool's own dependency
+    _, weld = np.unique(np.round(points, 5), axis=0, return_inverse=True)
+    weld = weld.reshape(-1)
+    welded = np.zeros((int(weld.max()) + 1, 3))
+    welded[weld] = points
+    joined = weld[tris]
+    joined = joined[(joined[:, 0] != joined[:, 1]) & (joined[:, 1] != joined[:, 2]) & (joined[:, 0] != joined[:, 2])]
+    source_area = _surface(welded, joined)
+    for _ in range(AREA_ATTEMPTS):
+        if share >= len(joined):
+            return points, uv, tris
+        kept, kept_tris, collapses = fast_simplification.simplify(
+            welded.astype(np.float32), joined.astype(np.int32), 1.0 - share / len(joined), return_collapses=True)
+        kept = np.asarray(kept, np.float64)
+        if len(kept_tris) and _surface(kept, kept_tris) >= area_kept * source_area:
+            break
+        share *= 2
+    else:
+        if len(tris) <= WHOLE_MATERIAL:
+            return points, uv, tris
+    _, _, mapping = fast_simplification.replay_simplification(
+        welded.astype(np.float32), joined.astype(np.int32), collapses)
+    mapping = np.asarray(mapping)                                # welded vertex -> kept vertex
+    nearest = np.lexsort((np.linalg.norm(welded - kept[mapping], axis=1), mapping))
+    first = nearest[np.r_[True, mapping[nearest][1:] != mapping[nearest][:-1]]]
+    kept[mapping[first]] = welded[first]
+    source = _corner_sources(points, tris, mapping[weld], kept, kept_tris)
+    pairs, corner_vertex = np.unique(np.stack([kept_tris.reshape(-1), source.reshape(-1)], axis=1), axis=0,
+                                     return_inverse=True)
+    return kept[pairs[:, 0]], uv[pairs[:, 1]], corner_vertex.reshape(-1, 3)
+
+
+def _corner_sources(points: np.ndarray, tris: np.ndarray, kept_of: np.ndarray, kept: np.ndarray,
+                    kept_tris: np.ndarray) -> np.ndarray:
+    """Per corner of the kept triangles, the original vertex whose texture coordinate it takes: of
+    the vertices its kept vertex absorbed (``kept_of``: original vertex -> kept vertex), the one
+    whose normal is closest to the kept triangle's (an OBJ vertex at a hard edge belongs to one side)."""
+    corners = points[tris]
+    vertex_normals = np.zeros_like(points)
+    np.add.at(vertex_normals, tris.reshape(-1),
+              np.repeat(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), 3, axis=0))
+    vertex_normals /= np.maximum(np.linalg.norm(vertex_normals, axis=1, keepdims=True), 1e-12)
+    kept_corners = kept[kept_tris]
+    normals = np.cross(kept_corners[:, 1] - kept_corners[:, 0], kept_corners[:, 2] - kept_corners[:, 0])
+    order = np.argsort(kept_of, kind="stable")
+    starts = np.searchsorted(kept_of[order], np.arange(len(kept) + 1))
+    source = np.empty(kept_tris.shape, np.int64)
+    for f, triangle in enumerate(kept_tris):
+        for c, vertex in enumerate(triangle):
+            absorbed = order[starts[vertex]:starts[vertex + 1]]
+            source[f, c] = absorbed[np.argmax(vertex_normals[absorbed] @ normals[f])]
+    return source
+
+
+def _surface(points: np.ndarray, tris: np.ndarray) -> float:
+    """Area of a mesh's triangles, a triangle given twice (both sides of a sheet) counted once."""
+    _, first = np.unique(np.sort(tris, axis=1), axis=0, return_index=True)
+    corners = points[tris[first]]
+    return float(0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]),
+                                      axis=1).sum())
 
 
 def _materials(mtl: Sequence[dict], used: np.ndarray) -> tuple[list[LibraryMaterial], dict[str, bytes]]:
@@ -504,7 +625,7 @@ def import_furniture(archives: Sequence[Path], out: Path, rules: dict[str, Rule]
                 if len(kept) == per_kind:
                     break
                 converted = convert(entry, archives_open[entry.archive], rules[kind])
-                if len(converted.mesh.faces) <= max(OVER_BUDGET * converted.budget, ABSOLUTE_BUDGET):
+                if len(converted.mesh.faces) <= allowed_triangles(rules[kind], converted.budget):
                     kept.append((entry, converted))
                 elif smallest is None or len(converted.mesh.faces) < len(smallest[1].mesh.faces):
                     smallest = (entry, converted)

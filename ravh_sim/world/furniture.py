@@ -1,5 +1,6 @@
 """Procedural models of what the furniture library has no model of: door leaves, window frames,
-worktops, pictures, mirrors, poufs, keyboards, wall sconces, toothbrushes and the robot's station.
+worktops, pictures, mirrors, poufs, keyboards, wall sconces, toothbrushes, wall shelves (a board on
+brackets: the library's shelves are bookcases), toilet brushes and the robot's station.
 
 Why: these are parts of the house's structure (a door leaf in its doorway, a window in its wall
 opening, a worktop cut to the units below it) or small items the open catalogues lack; everything
@@ -113,9 +114,6 @@ def _frame(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float, f: 
 # --- seating ------------------------------------------------------------------------------
 
 
-"""Width (m) of the long seat of a 'Corner Sofa'."""
-
-
 def _pouf(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     rx, ry = d / 2, w / 2
     bevel = min(d, w, h)
@@ -161,6 +159,26 @@ def _toothbrush(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
         top = (d / 2, side * (w / 2 - 0.2 * r), 0.85 * h)
         parts += [_beam((d / 2, side * 0.3 * r, 0.1 * h), top, 0.12 * r, colour),
                   _beam(top, (d / 2, top[1], h), 0.14 * r, 'white', 0.3 * r)]
+    return parts
+
+
+def _toilet_brush(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
+    """A toilet brush standing in its holder: a tapered pot, the handle rising from it, a knob."""
+    r = min(d, w) / 2
+    pot = 0.45 * h
+    return [_disc(d / 2, 0.0, 0.0, pot, 0.95 * r, 0.95 * r, 'white', 12, top=0.85),
+            _rod((d / 2, 0.0, pot), (d / 2, 0.0, 0.93 * h), 0.08 * r, 'chrome', 8),
+            _disc(d / 2, 0.0, 0.93 * h, h, 0.18 * r, 0.18 * r, 'chrome', 8, top=0.7)]
+
+
+def _wall_shelf(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
+    """A board on two brackets fixed to the wall at x = 0 (a wall shelf; the box is its board's
+    thickness and the brackets' depth below it)."""
+    board, bracket = _pick((('wood_medium', 'metal'), ('white', 'white'), ('wood_dark', 'black')), v)
+    t = 0.6 * h
+    parts = [_blk(0.0, d, -w / 2, w / 2, h - t, h, board)]
+    for y in (-0.35 * w, 0.35 * w):
+        parts.append(_blk(0.0, 0.7 * d, y - 0.01, y + 0.01, 0.0, h - t, bracket))
     return parts
 
 
@@ -330,10 +348,11 @@ class _Spec:
 
 
 _SPECS: dict[str, _Spec] = {
-    'Counter': _Spec(_counter, 4), 'Door': _Spec(_door, 3), 'Keyboard': _Spec(_keyboard, 1),
-    'Lighter': _Spec(_lighter, 1),
+    'Brush': _Spec(_toilet_brush, 1), 'Counter': _Spec(_counter, 4), 'Door': _Spec(_door, 3),
+    'Keyboard': _Spec(_keyboard, 1), 'Lighter': _Spec(_lighter, 1),
     'Mirror': _Spec(_mirror, 3), 'Picture': _Spec(_picture, 4), 'Pouf': _Spec(_pouf, 4),
-    'Station': _Spec(_station, 1), 'Toothbrush': _Spec(_toothbrush, 1), 'Wall': _Spec(_window, 3),
+    'Shelf': _Spec(_wall_shelf, 3), 'Station': _Spec(_station, 1), 'Toothbrush': _Spec(_toothbrush, 1),
+    'Wall': _Spec(_window, 3),
 }
 _GENERIC = _Spec(_generic, 1)
 

@@ -11,7 +11,8 @@ A :class:`Placed` object holds its model in its body frame (box centre at the or
 and the body's pose; the world turns it by ``yaw`` about z and moves it to ``position``. The model is
 a furniture-library model (:mod:`ravh_sim.world.library`: modelled, textured, colliding as its own
 triangles) where the library has one of the object's kind, else procedural convex parts
-(:mod:`ravh_sim.world.furniture`: doors, windows, worktops, pictures, mirrors, the station).
+(:mod:`ravh_sim.world.furniture`: doors, windows, worktops, pictures, mirrors, wall shelves,
+toilet brushes, the station).
 """
 from __future__ import annotations
 
