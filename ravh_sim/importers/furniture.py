@@ -472,11 +472,9 @@ def _whole_pieces(points: np.ndarray, tris: np.ndarray, share: int) -> np.ndarra
     collapses such a piece (a table's top is a box of 12 triangles) for less than the cost of thinning
     a curved part, and then the piece is gone, not coarser."""
     pieces = piece_labels(points, tris)
-    corners = points[tris]
-    area = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
     counts = np.bincount(pieces)
     small = np.flatnonzero(counts <= WHOLE_PIECE)
-    small = small[np.argsort(-np.bincount(pieces, weights=area)[small], kind="stable")]
+    small = small[np.argsort(-np.bincount(pieces, weights=_triangle_areas(points, tris))[small], kind="stable")]
     chosen = small[np.cumsum(counts[small]) <= share // 2]
     return np.isin(pieces, chosen)
 
@@ -550,9 +548,12 @@ def _corner_sources(points: np.ndarray, tris: np.ndarray, kept_of: np.ndarray, k
 def _surface(points: np.ndarray, tris: np.ndarray) -> float:
     """Area of a mesh's triangles, a triangle given twice (both sides of a sheet) counted once."""
     _, first = np.unique(np.sort(tris, axis=1), axis=0, return_index=True)
-    corners = points[tris[first]]
-    return float(0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]),
-                                      axis=1).sum())
+    return float(_triangle_areas(points, tris[first]).sum())
+
+
+def _triangle_areas(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
+    corners = points[tris]
+    return 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
 
 
 def _materials(mtl: Sequence[dict], used: np.ndarray) -> tuple[list[LibraryMaterial], dict[str, bytes]]:
