@@ -114,16 +114,14 @@ class SceneBuilder:
             if visual.model is not None:
                 record = library.record(source)
                 slots = np.array([self.materials.library(record.id, k, m) for k, m in enumerate(record.materials)])
-                if self.detail == "dataset":
-                    arrays = model_arrays(library.dataset_model(source), slots)
-                    # kept in single precision: the dataset level has several times the corners
-                    arrays = BodyArrays(arrays.local.astype(np.float32), arrays.normals.astype(np.float32),
-                                        arrays.materials, arrays.uvs)
-                    self._arrays[key] = arrays
-                else:
-                    self._arrays[key] = model_arrays(source, slots)
+                fitted = library.dataset_model(source) if self.detail == "dataset" else source
+                arrays = model_arrays(fitted, slots)
             else:
-                self._arrays[key] = palette_arrays(source)
+                arrays = palette_arrays(source)
+            # kept in single precision, what the GPU reads: a house's unique models are as many
+            # corners as the vertex buffer (several times more at the dataset level)
+            self._arrays[key] = BodyArrays(arrays.local.astype(np.float32), arrays.normals.astype(np.float32),
+                                           arrays.materials.astype(np.int32), arrays.uvs.astype(np.float32))
             self._kept[key] = source
         return self._arrays[key]
 
