@@ -112,8 +112,8 @@ class Rule:
     that reads as a microwave); ``least``/``most`` bound the kind's triangle budget (default
     MIN_TRIANGLES / TRIANGLE_BUDGET, read when used); ``dataset``: its models get a finer dataset level
     (DATASET_FACTOR); ``foliage``: its models are mostly leaves, which decimation thins rather than
-    breaks, so their simplification keeps no share of the surface (AREA_KEPT): a plant's thousands of
-    leaves would take it past any budget."""
+    breaks, so their simplification keeps FOLIAGE_AREA_KEPT of the surface, not AREA_KEPT: a plant
+    keeping 70 % of its thousands of leaves would be past any budget."""
     name: str
     categories: tuple[str, ...] = INDOOR
     exclude: str = r"$^"

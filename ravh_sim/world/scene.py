@@ -98,7 +98,7 @@ class World:
         pb.setTimeStep(1.0 / physics_hz, physicsClientId=self.client)
         self._models_now: dict[str, int] = {}     # object -> model of its body, once load_model swapped it
         self._parked: dict[tuple[str, int], tuple] = {}      # (object, model) -> swapped-out body (load_model)
-        self._model_shapes: dict[bytes, int] = {}            # fitted library model's digest -> its shape
+        self._model_shapes: dict[Path, int] = {}             # fitted library model's cached OBJ -> its shape
         self.instances: list[Instance] = []
         self._by_name: dict[str, Instance] = {}
         self.triangle_count = 0
@@ -235,13 +235,12 @@ class World:
         model fitted to the same box (a table's four plates, a row of chairs) shares one shape: a
         shape costs ~0.5 kB a triangle, and never leaves the client (see :meth:`load_model`)."""
         key = record(fitted).id.encode() + np.round(fitted.vertices, 5).tobytes()
-        digest = hashlib.sha1(key).digest()
-        if digest not in self._model_shapes:
-            path = cached_asset(key, ".obj", lambda p: fitted.export(p, file_type="obj", include_normals=False,
-                                                                  include_texture=False))
-            self._model_shapes[digest] = pb.createCollisionShape(
+        path = cached_asset(key, ".obj", lambda p: fitted.export(p, file_type="obj", include_normals=False,
+                                                              include_texture=False))
+        if path not in self._model_shapes:
+            self._model_shapes[path] = pb.createCollisionShape(
                 pb.GEOM_MESH, fileName=str(path), flags=pb.GEOM_FORCE_CONCAVE_TRIMESH, physicsClientId=self.client)
-        return self._model_shapes[digest]
+        return self._model_shapes[path]
 
     def _parts_collision(self, placed: Placed) -> int:
         """A compound of one convex hull per model part, loaded from a cached OBJ file."""
