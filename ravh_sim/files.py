@@ -2,11 +2,14 @@
 
 Every file goes to a temporary name in its own folder, is fsynced and renamed into place: a reader,
 a full disk or a Ctrl-C at any instant leaves the old file or the new one, never a torn one. Images
-are encoded in memory first, so a failed encoding writes nothing at all.
+are encoded in memory first, so a failed encoding writes nothing at all. Generated assets (meshes,
+textures) go to a content-addressed cache the same way (:func:`cached_asset`).
 """
 from __future__ import annotations
 
+import hashlib
 import os
+from collections.abc import Callable
 from pathlib import Path
 
 import cv2
@@ -71,3 +74,22 @@ def read_png(path: Path) -> np.ndarray:
     if image is None:
         raise OSError(f"{path}: cannot read the PNG")
     return cv2.cvtColor(image, cv2.COLOR_BGR2RGB) if image.ndim == 3 else image
+
+
+def cache_dir() -> Path:
+    """Where generated meshes and textures go (content-addressed, safe to share between runs)."""
+    root = os.environ.get("RAVH_CACHE") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "ravh_sim")
+    path = Path(root) / "assets"
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def cached_asset(key: bytes, suffix: str, write: Callable[[Path], object]) -> Path:
+    """A content-addressed file in the asset cache, written atomically if missing."""
+    path = cache_dir() / (hashlib.sha1(key).hexdigest()[:20] + suffix)
+    if not path.exists():
+        tmp = path.with_name(f"{path.stem}.{os.getpid()}.tmp{suffix}")
+        write(tmp)
+        os.replace(tmp, path)
+    return path

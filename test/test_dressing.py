@@ -159,6 +159,35 @@ def test_big_things_collide_and_rugs_do_not(dressed_world):
         assert bool(shapes) == (d.slot.type != "Rug"), d.id
 
 
+def test_rugs_lie_under_feet_never_under_a_base(houses):
+    """Rays up through each rug's band on a 1 cm grid, from just over the ground (pybullet's colliders;
+    rugs have none): what stands in it are islands no wider than a foot (FOOT_SIZE and a grid cell):
+    legs, not a bed's base or a cabinet's plinth. In house 2 a rug has a bed's or a nightstand's feet
+    on it."""
+    import cv2
+    house = houses[2]
+    stood_on = 0
+    with World(house, _settings(house, "lived-in")) as world:
+        rugs = [d for d in dressing(house, world.state.models, "lived-in", world.state.seed) if d.slot.type == "Rug"]
+        assert rugs
+        for d in rugs:
+            (x, y, z), yaw = d.position, d.yaw
+            depth, width, height = d.slot.size
+            u, v = np.meshgrid(np.arange(-depth / 2, depth / 2, 0.01), np.arange(-width / 2, width / 2, 0.01))
+            c, s = math.cos(yaw), math.sin(yaw)
+            xy = np.stack([x + c * u - s * v, y + s * u + c * v], axis=-1).reshape(-1, 2)
+            floor = house.room(d.slot.room).floor_z
+            bottom = np.column_stack([xy, np.full(len(xy), floor - 0.0005)])
+            up = [0.0, 0.0, z + height / 2 - floor]
+            hit = np.concatenate([world.cast_rays(part, part + up)[0] for part in np.array_split(bottom, 4)])
+            occupied = (hit >= 0).reshape(u.shape).astype(np.uint8)
+            count, _, stats, _ = cv2.connectedComponentsWithStats(occupied, connectivity=8)
+            stood_on += count > 1                                   # label 0: the free floor
+            widest = stats[1:, [cv2.CC_STAT_WIDTH, cv2.CC_STAT_HEIGHT]].max(initial=0) * 0.01
+            assert widest <= dressing_module.FOOT_SIZE + 0.02, (d.id, widest)
+    assert stood_on >= 1
+
+
 def test_masks_show_dressing_instances(dressed_world):
     world = dressed_world
     camera = SmartCamera(world, PROFILE.camera)
@@ -363,3 +392,46 @@ def test_book_rows_and_stacks_are_seeded(houses):
     first = [(d.id, d.slot.model_id, d.position, d.yaw) for d in _shelf_books(house)]
     assert first == [(d.id, d.slot.model_id, d.position, d.yaw) for d in _shelf_books(house)]
     assert first != [(d.id, d.slot.model_id, d.position, d.yaw) for d in _shelf_books(house, seed=5)]
+
+
+def test_wall_art_hangs_framed_pictures_painted_here(houses):
+    """Every wall art variant fills its box, shows its picture on the front (texture coordinates over
+    0..1 on the face at the front, recessed behind a frame where it has one), its picture is a real
+    image (not one flat colour, different between variants), painted once into the asset cache and
+    rebuilt the same; houses 15 and 23 hang some, and their own pictures are wall art too, not all one."""
+    import cv2
+
+    from ravh_sim.world import made_art
+    from ravh_sim.world.solids import object_parts
+    size = made_art.SIZE
+    pictures = []
+    for record in made_art.records("Dressing/wall_art"):
+        model = made_art.model.__wrapped__(record.id, size)
+        assert np.allclose(np.ptp(model.vertices, axis=0), size, atol=1e-9) and model.is_winding_consistent
+        materials = model.face_attributes["material"]
+        picture = np.flatnonzero(materials == 2)
+        texture = model.metadata["record"].materials[2].texture
+        assert texture and len(picture)
+        corners = model.vertices[model.faces[picture]].reshape(-1, 3)
+        uv = np.asarray(model.visual.uv)[model.faces[picture]].reshape(-1, 2)
+        front = corners[:, 0] == corners[:, 0].max()
+        assert np.allclose(uv[front].min(axis=0), 0) and np.allclose(uv[front].max(axis=0), 1)
+        assert (corners[:, 0].max() < size[0] / 2) == (made_art._presentation(int(record.id.split("/")[-1]))[0]
+                                                      is not None)
+        image = cv2.imread(texture)
+        assert image.shape[:2] == made_art.ART_TEXELS[::-1] and image.std() > 10
+        pictures.append(image)
+        again = made_art.model.__wrapped__(record.id, size)
+        assert np.array_equal(again.vertices, model.vertices)
+    assert len({p.tobytes() for p in pictures}) == len(pictures) == made_art.VARIANTS
+    painted = made_art.painting(3)
+    written = painted.stat().st_mtime_ns
+    assert made_art.painting(3) == painted and painted.stat().st_mtime_ns == written
+    for number in (15, 23):
+        house = houses[number]
+        settings = _settings(house, "lived-in")
+        art = [d for d in dressing(house, settings.models, "lived-in", settings.seed) if d.slot.type == "Picture"]
+        assert art and all(made_art.is_made(d.slot.model_id) for d in art)
+        own = [object_parts(house, o, None).model for o in house.objects if o.type == "Picture"]
+        assert own and all(m is not None and made_art.is_made(m.metadata["record"].id) for m in own)
+        assert len({m.metadata["record"].id for m in own}) > 1, "a house's pictures differ"

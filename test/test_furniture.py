@@ -26,14 +26,14 @@ from ravh_sim.world.palette import PALETTE, Palette
 
 # Upstream Robot@VirtualHome model counts per type (from the house data).
 UPSTREAM_MODELS = {
-    'Counter': 4, 'Door': 3, 'Keyboard': 1, 'Lighter': 1, 'Mirror': 2, 'Picture': 4, 'Pouf': 4, 'Station': 1,
+    'Counter': 4, 'Door': 3, 'Keyboard': 1, 'Lighter': 1, 'Mirror': 2, 'Pouf': 4, 'Station': 1,
     'Toothbrush': 1, 'Wall': 3, 'Shelf': 3, 'Brush': 1,
 }
 
 # Typical upstream box sizes (sx, sy, sz) in metres; other types use a generic 0.6 m box.
 TYPICAL = {
     'Counter': (0.6, 0.58, 0.04), 'Door': (0.26, 0.94, 2.5), 'Mirror': (0.68, 0.04, 1.05),
-    'Picture': (0.68, 0.04, 0.48), 'Wall': (1.36, 0.17, 1.36), 'Station': (0.5, 0.5, 0.02),
+    'Wall': (1.36, 0.17, 1.36), 'Station': (0.5, 0.5, 0.02),
     'Keyboard': (0.44, 0.14, 0.03), 'Toothbrush': (0.06, 0.11, 0.2), 'Pouf': (0.5, 0.5, 0.4),
     'Shelf': (0.67, 0.24, 0.04), 'Brush': (0.17, 0.17, 0.44),
 }
@@ -111,7 +111,7 @@ def test_variant_index_wraps_and_facing_wraps():
     assert same_mesh(build_model('Pouf', (0.5, 0.5, 0.4), 0, 6), build_model('Pouf', (0.5, 0.5, 0.4), 0, 2))
 
 
-@pytest.mark.parametrize('object_type', ['Door', 'Counter', 'Picture', 'Wall'])
+@pytest.mark.parametrize('object_type', ['Door', 'Counter', 'Mirror', 'Wall'])
 def test_models_are_deterministic(object_type, tmp_path):
     a = build_model(object_type, typical(object_type), 1, 3)
     b = build_model(object_type, typical(object_type), 1, 3)
@@ -124,7 +124,7 @@ def test_models_are_deterministic(object_type, tmp_path):
 
 def test_bad_sizes_still_give_a_model():
     for size in [(0.0, 0.5, 0.5), (-0.4, 0.5, 0.5), (float('nan'), 0.5, 0.5)]:
-        mesh = build_model('Picture', size, 0)
+        mesh = build_model('Mirror', size, 0)
         assert np.isfinite(mesh.vertices).all() and mesh.area_faces.min() > 0
 
 
@@ -349,3 +349,19 @@ def test_an_appliance_keeps_its_front_where_a_turned_model_would_fit_better(hous
     walls = [(w.a, w.b) for w in house.walls if w.room == washer.room and w.kind != "lintel"]
     side = round((placed.front - washer.yaw) / (np.pi / 2)) % 4
     assert side_distances(washer.position[:2], washer.yaw, washer.size, walls)[side] > 0.3
+
+
+def test_an_appliance_takes_a_model_of_its_width_before_a_squeezed_one():
+    """A 71 cm fridge box takes the 59 cm combi (stretched), not the 93 cm side-by-side squeezed to
+    30 cm doors, though the side-by-side's proportions fit better; with no model of its width it
+    takes the best proportions."""
+    from ravh_sim.world import library
+    from ravh_sim.world.solids import APPLIANCE_LEAST_WIDTH_SCALE, _library_choice
+    fridges = library.models_of("Refrigerator")
+    box = np.array([0.63, 0.71, 1.98])                              # depth, front width, height at facing 0
+    record, facing = _library_choice(fridges, 0, box, 0, "door")
+    assert facing == 0 and record.size[1] * APPLIANCE_LEAST_WIDTH_SCALE <= box[1]
+    assert min(fridges, key=lambda r: library.misfit(np.asarray(r.size), box)) is not record
+    tiny = np.array([0.3, 0.3, 1.0])                                 # narrower than every model
+    best = min(fridges, key=lambda r: library.misfit(np.asarray(r.size), tiny))
+    assert _library_choice(fridges, 0, tiny, 0, "door")[0] is best

@@ -23,7 +23,7 @@ from ravh_sim.importers.furniture import (
     triangle_budget,
 )
 from ravh_sim.paths import FURNITURE_DIR
-from ravh_sim.world import library
+from ravh_sim.world import library, made_art
 from ravh_sim.world.furniture import OBJECT_TYPES
 from ravh_sim.world.library import LibraryCatalog, kind_of, models_of
 from ravh_sim.world.solids import model_count, object_parts
@@ -35,7 +35,7 @@ FEWER_THAN_THREE = {"Sink": (2, "the catalogues hold two basins with taps that s
 """Library kinds of types whose upstream objects come in several model variants (house data) that have
 fewer than three models: how many, and why (each checked to apply)."""
 PROCEDURAL = {"Counter": "a worktop is cut to the units under it", "Door": "a leaf in its doorway",
-              "Wall": "a window frame in its wall opening", "Picture": "no framed pictures in the catalogues",
+              "Wall": "a window frame in its wall opening",
               "Mirror": "no wall mirrors in the catalogues", "Pouf": "one ottoman only in the catalogues",
               "Station": "the robot's own dock",
               "Keyboard": "the catalogues' keyboard is a piano keyboard",
@@ -210,13 +210,18 @@ def test_every_house_type_has_a_library_model_or_a_procedural_reason(houses):
     for object_type, prefab in sorted(types):
         if object_type in PROCEDURAL:
             assert object_type in OBJECT_TYPES and not models_of(kind_of(object_type, prefab))
+        elif object_type == "Picture":                   # no framed pictures in the catalogues: made_art's
+            house, picture = next((h, o) for h in houses.values() for o in h.objects if o.type == "Picture")
+            assert not models_of(kind_of(object_type, prefab)) and model_count(picture) == made_art.VARIANTS
+            assert made_art.is_made(library.record(object_parts(house, picture, None).model).id)
         else:
             assert models_of(kind_of(object_type, prefab)), (object_type, prefab)
     assert set(OBJECT_TYPES) == set(PROCEDURAL)
 
 
 def test_types_with_upstream_variants_have_three_library_models(houses):
-    upstream = {o.type for house in houses.values() for o in house.objects if len(o.models) > 1} - set(PROCEDURAL)
+    upstream = {o.type for house in houses.values() for o in house.objects if len(o.models) > 1} - set(PROCEDURAL) - {
+        "Picture"}                                      # made here (made_art), 16 of them
     assert {"Bed", "Chair", "Sink", "Sofa"} <= upstream
     fewer = {}
     for object_type in sorted(upstream):
@@ -333,13 +338,19 @@ def test_fit_fills_the_box_within_its_proportions_and_stays_inside():
 
 
 def test_the_default_variant_is_the_best_proportioned_model(houses):
-    """Variants are the kind's models ranked by how well they fit the object's box."""
+    """Variants are the kind's models ranked by how well they fit the object's box; an appliance's
+    among the models its box's width does not squeeze (see the next test)."""
+    from ravh_sim.world.facing import OPENING_FRONT
+    from ravh_sim.world.solids import APPLIANCE_LEAST_WIDTH_SCALE
     checked = 0
     for obj in [o for o in houses[15].objects if models_of(kind_of(o.type, o.prefab))]:
         default = object_parts(houses[15], obj, 0)
         quarter = round((default.front - default.yaw) / (np.pi / 2)) % 2      # the box turned to the front
         size = np.asarray(obj.box(0).size)[[1, 0, 2] if quarter else [0, 1, 2]]
-        misfits = [library.misfit(np.asarray(r.size), size) for r in models_of(kind_of(obj.type, obj.prefab))]
+        records = models_of(kind_of(obj.type, obj.prefab))
+        if obj.type in OPENING_FRONT:
+            records = tuple(r for r in records if size[1] >= APPLIANCE_LEAST_WIDTH_SCALE * r.size[1]) or records
+        misfits = [library.misfit(np.asarray(r.size), size) for r in records]
         assert library.misfit(np.asarray(library.record(default.model).size), size) == pytest.approx(min(misfits))
         checked += 1
     assert checked > 30

@@ -18,12 +18,13 @@ import cv2
 import numpy as np
 import pybullet as pb
 
+from ravh_sim.files import cached_asset
 from ravh_sim.look.changes import ChangeWatch
 from ravh_sim.world import paints
 from ravh_sim.world.library import palette_stand_in
 from ravh_sim.world.mesh import colours, write_palette_obj
 from ravh_sim.world.palette import PALETTE
-from ravh_sim.world.scene import Visual, World, cached_asset
+from ravh_sim.world.scene import Visual, World
 from ravh_sim.world.structure import write_textured_obj
 
 

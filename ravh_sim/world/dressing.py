@@ -23,8 +23,9 @@ How a layout is made (:func:`layout`), in plain Python, with no pybullet:
   the support lies inside it, and enough of its footprint touches), and (b) keeps clear of every other
   object's pieces (:attr:`Placed.bounds`; on a bookcase, of its own sides, back and dividers too), the
   walls and every dressing object placed before it.
-  Things on the floor keep clear of doorways, passages and the robot's station; rugs lie under
-  nothing that stands on the floor. A slot with no room on its support is left out.
+  Things on the floor keep clear of doorways, passages and the robot's station; a rug lies under
+  nothing that stands on the floor but feet (a bed's, a nightstand's legs: a pile takes them), never
+  under a base. A slot with no room on its support is left out.
 
 A dressing object collides as its own triangles (the laser sees what the camera draws) unless it is a
 rug (flat on the floor: the robot drives over it). Dressing objects are ``kind: dressing`` instances
@@ -44,7 +45,7 @@ import numpy as np
 import trimesh
 from shapely.geometry import Point, Polygon
 
-from ravh_sim.world import library, made_objects, soft_furnishings
+from ravh_sim.world import library, made_art, made_objects, soft_furnishings
 from ravh_sim.world.house import House, HouseObject, Room
 from ravh_sim.world.instances import build_instances
 from ravh_sim.world.solids import Placed, _fitted, _piece_bounds, object_parts
@@ -56,6 +57,8 @@ DRESSING_TAG = "dressing"
 REST_TOLERANCE = 0.0015       # m: a support's triangle this close above an object's bottom is its surface
 FLOOR_CLEARANCE = 0.9         # m: a floor object's centre from a doorway's or passage's centre, the station
 CANDIDATES = 24               # positions tried per slot
+FOOT_SIZE = 0.12              # m: furniture touches a rug's band with feet this small (legs, castors) or
+                              # with a base; a rug goes under feet, as a pile takes them, never a base
 REST_SAMPLES = 9              # vertical lines per side of a footprint that find its support (odd: the
                               # coarse lattice is every other line; 5 missed a mattress rising 2 mm
 REST_INSET = 0.003            # between them), this far inside its edges
@@ -76,6 +79,7 @@ class Spec:
     stretch: bool = False
     collides: bool = True
     facing: str = "random"             # random | support (the support's front) | out (into the room)
+    unlike: tuple[str, ...] = ()       # words in the ids of the kinds' models that are not this thing
 
 
 def _s(type_: str, kinds: str, box: tuple[float, float, float], tidy: int, lived_in: int, **kw) -> Spec:
@@ -116,7 +120,8 @@ BED = (_s("Duvet", "Dressing/duvet", (1.4, 1.6, 0.12), 1, 1, stretch=True, flat=
 SOFA = (_s("Cushion", "Dressing/cushion", (0.2, 0.45, 0.45), 1, 3, flat=0.04, touching=0.4, facing="support"),
         _s("Throw", "Dressing/throw", (0.6, 1.0, 0.07), 0, 1, stretch=True, flat=0.05, touching=0.4,
            facing="support"))
-RUG = _s("Rug", "Dressing/rug", (1.6, 2.2, 0.02), 1, 1, stretch=True, collides=False, facing="support")
+RUG = _s("Rug", "Dressing/rug", (1.6, 2.2, 0.02), 1, 1, stretch=True, collides=False, facing="support",
+         unlike=("bathmat", "doormat"))         # a living room's or a bedroom's rug, not a mat made large
 CURTAIN = _s("Curtain", "Dressing/curtain", (0.2, 1.6, 2.4), 0, 1, stretch=True, facing="out")   # a pair, drawn open
 BLIND = _s("Blind", "Dressing/blind", (0.06, 1.2, 0.6), 0, 1, stretch=True, facing="out")
 FLOOR_PLANT = _s("Plant", "Dressing/floor_plant Decoration", (0.6, 0.6, 1.1), 0, 1)
@@ -180,10 +185,12 @@ class Dressed:
 
 
 def _made_here(model_id: str) -> Callable[[str, tuple[float, float, float]], trimesh.Trimesh] | None:
-    """The builder of a model made here to its box (soft furnishings, books, dish racks); None for a
-    library model."""
+    """The builder of a model made here to its box (soft furnishings, wall art, books, dish racks); None
+    for a library model."""
     if soft_furnishings.is_soft(model_id):
         return soft_furnishings.model
+    if made_art.is_made(model_id):
+        return made_art.model
     if made_objects.is_made(model_id):
         return made_objects.model
     return None
@@ -192,9 +199,11 @@ def _made_here(model_id: str) -> Callable[[str, tuple[float, float, float]], tri
 def kind_models(spec: Spec) -> tuple[library.LibraryRecord, ...]:
     """The library models of the first of the spec's kinds that has any, or else the models made here
     (:mod:`ravh_sim.world.soft_furnishings`: pillows, duvets, cushions, throws;
-    :mod:`ravh_sim.world.made_objects`: books, dish racks); empty: none."""
+    :mod:`ravh_sim.world.made_art`: wall art; :mod:`ravh_sim.world.made_objects`: books, dish racks);
+    empty: none."""
     for kind in spec.kinds:
-        found = library.models_of(kind) or soft_furnishings.records(kind) or made_objects.records(kind)
+        found = (library.models_of(kind) or soft_furnishings.records(kind) or made_art.records(kind)
+                 or made_objects.records(kind))
         if found:
             return found
     return ()
@@ -314,10 +323,12 @@ little plant does not become a tree."""
 
 def _suitable(records: tuple[library.LibraryRecord, ...], spec: Spec, box_size: tuple[float, float, float]
               ) -> tuple[library.LibraryRecord, ...]:
-    """The models that fit the box without absurd scaling; for things hung flat (on a wall, at a
-    window), only flat ones."""
+    """The models that fit the box without absurd scaling and are the spec's thing (``Spec.unlike``);
+    for things hung flat (on a wall, at a window), only flat ones."""
     out = []
     for record in records:
+        if any(word in record.id for word in spec.unlike):
+            continue
         natural = np.maximum(np.asarray(record.size, np.float64), 1e-4)
         if spec.facing == "out" and natural[0] > 0.5 * max(natural[1], natural[2]):
             continue
@@ -413,17 +424,30 @@ class _Scene:
             self._triangles[object_id] = np.asarray(mesh.vertices)[np.asarray(mesh.faces)] @ turn.T + p.position
         return self._triangles[object_id]
 
-    def clear(self, outline: Polygon, z0: float, z1: float, skip: str = "") -> bool:
+    def clear(self, outline: Polygon, z0: float, z1: float, skip: str = "", under_feet: bool = False) -> bool:
         """Whether a box of ``outline`` from z0 to z1 keeps clear of every object but ``skip``, the
-        walls and the dressing placed so far."""
+        walls and the dressing placed so far; ``under_feet``: objects may stand on it by their feet
+        (:meth:`only_feet`)."""
         cx, cy = outline.centroid.x, outline.centroid.y
         for oid, obstacles in self.obstacles.items():
             if oid == skip:
                 continue
             p = self.placed[oid].position
-            if abs(p[0] - cx) < 4.0 and abs(p[1] - cy) < 4.0 and _hits(obstacles, outline, z0, z1):
+            if abs(p[0] - cx) < 4.0 and abs(p[1] - cy) < 4.0 and _hits(obstacles, outline, z0, z1) and not (
+                    under_feet and self.only_feet(oid, outline, z1)):
                 return False
         return not _hits(self.walls, outline, z0, z1) and not _hits(self.dressed, outline, z0, z1)
+
+    def only_feet(self, object_id: str, outline: Polygon, z1: float) -> bool:
+        """Whether all of the object that reaches below ``z1`` over ``outline`` is feet: triangles no
+        wider than FOOT_SIZE (legs, castors; a sofa's base or a cabinet's plinth is wider)."""
+        triangles = self.triangles(object_id)
+        low = triangles[triangles[:, :, 2].min(axis=1) < z1]
+        x0, y0, x1, y1 = outline.bounds
+        lo, hi = low[:, :, :2].min(axis=1), low[:, :, :2].max(axis=1)
+        near = low[(hi[:, 0] >= x0) & (lo[:, 0] <= x1) & (hi[:, 1] >= y0) & (lo[:, 1] <= y1)]
+        over = [t for t in near if Polygon(t[:, :2]).buffer(1e-6).intersects(outline)]
+        return all(np.ptp(t[:, :2], axis=0).max() <= FOOT_SIZE for t in over)
 
 
 def _hits(obstacles: Sequence[_Obstacle], outline: Polygon, z0: float, z1: float) -> bool:
@@ -698,7 +722,8 @@ def _floor_ok(scene: _Scene, slot: Slot, x: float, y: float, room: Room) -> bool
 
 def _rug(scene: _Scene, slot: Slot, obj: HouseObject, rng: random.Random
          ) -> tuple[tuple[float, float, float], float] | None:
-    """A rug in front of a sofa or beside a bed's foot, partly under it where nothing of it stands."""
+    """A rug in front of a sofa or beside a bed's foot, partly under it where nothing of it stands but
+    feet (a coffee table's legs may stand on it)."""
     p = scene.placed[obj.id]
     lo, hi = p.extent()
     front = p.front if p.front is not None else p.yaw
@@ -712,9 +737,9 @@ def _rug(scene: _Scene, slot: Slot, obj: HouseObject, rng: random.Random
     beside = np.array([-ahead[1], ahead[0]])
     candidates = [(centre + ahead * (depth / 2 + d / 2 - overlap) + beside * shift, front)
                   for overlap in (0.3, 0.15, 0.0, -0.15) for shift in (0.0, 0.25, -0.25, 0.5, -0.5)]
-    if obj.type == "Bed":              # or along either side of a bed, turned across it
-        candidates += [(centre + beside * side * (width / 2 + d / 2 - overlap), front + math.pi / 2)
-                       for overlap in (0.2, 0.0) for side in (1, -1)]
+    if obj.type == "Bed":              # or along either side of a bed, turned across it, towards its foot
+        candidates += [(centre + beside * side * (width / 2 + d / 2 - overlap) + ahead * along, front + math.pi / 2)
+                       for overlap in (0.2, 0.0) for along in (0.0, 0.3, 0.6) for side in (1, -1)]
     for (x, y), yaw in candidates:
         x, y = x + rng.uniform(-0.02, 0.02), y + rng.uniform(-0.02, 0.02)
         outline = _rect((x, y), (d, w), yaw)
@@ -723,7 +748,7 @@ def _rug(scene: _Scene, slot: Slot, obj: HouseObject, rng: random.Random
         # the robot drives over a rug: it only keeps a doorway's and the station's own spot free
         if any(outline.distance(Point(*q)) < 0.45 for q in scene.keep_free):
             continue
-        if scene.clear(outline, room.floor_z + 0.001, room.floor_z + h):
+        if scene.clear(outline, room.floor_z + 0.001, room.floor_z + h, under_feet=True):
             return (float(x), float(y), room.floor_z + h / 2), yaw
     return None
 

@@ -201,41 +201,6 @@ def _lighter(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
 # --- screens, wall art, electronics ---------------------------------------------------------
 
 
-_ART = (('wood_medium', 'landscape'), ('black', 'blocks'), ('white', 'sea'), ('brass', 'circles'))
-
-
-def _picture(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
-    """Framed canvas hanging on a wall at x = 0; variants differ in frame and painting."""
-    frame, art = _pick(_ART, v)
-    f = min(0.05, 0.08 * min(w, h))
-    canvas = _canvas(0.5 * d, 0.7 * d, -w / 2 + f, w / 2 - f, f, h - f, art)
-    return _frame(0.0, d, -w / 2, w / 2, 0.0, h, f, frame) + canvas
-
-
-def _canvas(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float, art: str) -> Parts:
-    """A simple painting: background bands (layer 0) and motifs standing slightly proud of them."""
-    cw, ch, step = y1 - y0, z1 - z0, 0.15 * (x1 - x0)
-
-    def at(a: float, b: float, c: float, e: float, colour: str, layer: int = 1) -> trimesh.Trimesh:
-        return _blk(x0 if layer == 0 else x1, x1 + layer * step, y0 + a * cw, y0 + b * cw,
-                    z0 + c * ch, z0 + e * ch, colour)
-
-    if art == 'landscape':
-        return [at(0, 1, 0.45, 1, 'sky', 0), at(0, 1, 0, 0.45, 'art_green', 0),
-                at(0.1, 0.55, 0.3, 0.55, 'plant_dark'), at(0.7, 0.82, 0.65, 0.85, 'sun')]
-    if art == 'blocks':
-        return [at(0, 1, 0, 1, 'white', 0), at(0, 0.4, 0.55, 1, 'art_red'), at(0.7, 1, 0, 0.3, 'art_blue'),
-                at(0.45, 0.65, 0, 0.25, 'art_yellow'), at(0.4, 0.44, 0, 1, 'black', 2),
-                at(0, 1, 0.5, 0.54, 'black', 2)]
-    if art == 'sea':
-        return [at(0, 1, 0.5, 1, 'sky', 0), at(0, 1, 0.2, 0.5, 'sea', 0), at(0, 1, 0, 0.2, 'sand', 0),
-                at(0.55, 0.62, 0.5, 0.78, 'white'), at(0.15, 0.3, 0.75, 0.82, 'white')]
-    circles = ((0.3, 0.6, 0.22, 'art_red'), (0.65, 0.35, 0.2, 'art_yellow'), (0.72, 0.75, 0.12, 'sun'))
-    return [at(0, 1, 0, 1, 'grey_dark', 0)] + [
-        _rod((x1, y0 + a * cw, z0 + b * ch), (x1 + step, y0 + a * cw, z0 + b * ch), r * min(cw, ch), colour,
-             10) for a, b, r, colour in circles]
-
-
 def _mirror(d: float, w: float, h: float, v: int, prefab: str) -> Parts:
     """Wall mirror: wide wooden frame; thin black frame; oval in a brass rim."""
     style = v % 3
@@ -350,7 +315,7 @@ class _Spec:
 _SPECS: dict[str, _Spec] = {
     'Brush': _Spec(_toilet_brush, 1), 'Counter': _Spec(_counter, 4), 'Door': _Spec(_door, 3),
     'Keyboard': _Spec(_keyboard, 1), 'Lighter': _Spec(_lighter, 1),
-    'Mirror': _Spec(_mirror, 3), 'Picture': _Spec(_picture, 4), 'Pouf': _Spec(_pouf, 4),
+    'Mirror': _Spec(_mirror, 3), 'Pouf': _Spec(_pouf, 4),
     'Shelf': _Spec(_wall_shelf, 3), 'Station': _Spec(_station, 1), 'Toothbrush': _Spec(_toothbrush, 1),
     'Wall': _Spec(_window, 3),
 }

@@ -50,7 +50,7 @@ _CROCKERY = ((0.95, 0.95, 0.93), (0.90, 0.87, 0.80), (0.30, 0.40, 0.55), (0.75, 
 
 
 def is_made(model_id: str) -> bool:
-    return model_id.startswith(PREFIX)
+    return model_id.startswith(PREFIX) and model_id.split("/")[1] in KINDS      # not made/art/ (made_art)
 
 
 def _materials(kind: str, variant: int) -> list[library.LibraryMaterial]:
@@ -85,7 +85,7 @@ def records(kind: str) -> tuple[library.LibraryRecord, ...]:
 
 # --------------------------------------------------------------------------- pieces
 
-class _Parts:
+class Parts:
     """Convex pieces gathered into one mesh: vertices, faces, and a material and piece per face."""
 
     def __init__(self) -> None:
@@ -136,7 +136,7 @@ def _turn_x(angle: float) -> np.ndarray:
 SPINE = 0.005                 # m: how far a spine's rounding bulges
 
 
-def _book(parts: _Parts, depth: float, thickness: float, height: float, cover: int,
+def _book(parts: Parts, depth: float, thickness: float, height: float, cover: int,
           turn: np.ndarray, shift: tuple[float, float, float]) -> None:
     """One book standing on its bottom (z from 0), spine along +x, thickness along y, centred on x and y
     before ``turn`` and ``shift``: covers on the spine and sides, pages on the rest."""
@@ -147,7 +147,7 @@ def _book(parts: _Parts, depth: float, thickness: float, height: float, cover: i
     parts.prism(profile, 0.0, height, [cover] * 6 + [0], np.array([depth / 2 - r, 0.0]), turn, shift)
 
 
-def _book_row(parts: _Parts, size: np.ndarray, rng: random.Random) -> None:
+def _book_row(parts: Parts, size: np.ndarray, rng: random.Random) -> None:
     """Books standing side by side along y, spines at the front, filling the box's width; a gap or a
     book leaning on the last one in some rows."""
     d, w, h = size
@@ -181,7 +181,7 @@ def _book_row(parts: _Parts, size: np.ndarray, rng: random.Random) -> None:
         _book(parts, bd, t, bh, 1 + rng.randrange(_COVERS_A_MODEL), _turn_x(lean), shift)
 
 
-def _book_stack(parts: _Parts, size: np.ndarray, rng: random.Random) -> None:
+def _book_stack(parts: Parts, size: np.ndarray, rng: random.Random) -> None:
     """2-4 books lying flat, the biggest at the bottom, each turned a little on the one under it."""
     d, w, h = size
     n = rng.randrange(2, 5)
@@ -207,7 +207,7 @@ def _circle(segments: int) -> np.ndarray:
     return np.array([(math.cos(a), math.sin(a)) for a in np.linspace(0, 2 * math.pi, segments, endpoint=False)])
 
 
-def _dish_rack(parts: _Parts, size: np.ndarray, rng: random.Random) -> None:
+def _dish_rack(parts: Parts, size: np.ndarray, rng: random.Random) -> None:
     """A tray with a low rim, two rails, plates on edge leaning back together, cups upside down."""
     d, w, h = size
     base, rim, wall = 0.012, 0.05, 0.008
@@ -245,7 +245,7 @@ def model(model_id: str, size: tuple[float, float, float]) -> trimesh.Trimesh:
     kind, variant = model_id.removeprefix(PREFIX).split("/")
     box = np.asarray(size, np.float64)
     rng = random.Random(f"made/{kind}/{variant}/{'row' if box[2] >= ROW_HEIGHT else 'stack'}")
-    parts = _Parts()
+    parts = Parts()
     if kind == "dish_rack":
         _dish_rack(parts, box, rng)
     elif box[2] >= ROW_HEIGHT:

@@ -18,7 +18,6 @@ ravh_sim.render).
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import math
 import os
 import sys
@@ -30,6 +29,7 @@ import numpy as np
 import pybullet as pb
 import trimesh
 
+from ravh_sim.files import cached_asset
 from ravh_sim.poses import quaternion_from_yaw
 from ravh_sim.world.dressing import dressing
 from ravh_sim.world.footprint import STRUCTURE_KINDS, Instance, build_instances, dressing_instances
@@ -54,25 +54,6 @@ pieces had lost 10, walls among them: the laser and the robot passed through wal
 drew)."""
 CEILING_PAINT = "white"
 GROUND_HALF_SIZE = 60.0
-
-
-def cache_dir() -> Path:
-    """Where generated meshes and textures go (content-addressed, safe to share between runs)."""
-    root = os.environ.get("RAVH_CACHE") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "ravh_sim")
-    path = Path(root) / "assets"
-    path.mkdir(parents=True, exist_ok=True)
-    return path
-
-
-def cached_asset(key: bytes, suffix: str, write) -> Path:
-    """A content-addressed file in the asset cache, written atomically if missing."""
-    path = cache_dir() / (hashlib.sha1(key).hexdigest()[:20] + suffix)
-    if not path.exists():
-        tmp = path.with_name(f"{path.stem}.{os.getpid()}.tmp{suffix}")
-        write(tmp)
-        os.replace(tmp, path)
-    return path
 
 
 def connect() -> int:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import functools
 import math
+import zlib
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,7 +27,7 @@ import numpy as np
 import trimesh
 from shapely.geometry import MultiPoint, Polygon
 
-from ravh_sim.world import library
+from ravh_sim.world import library, made_art
 from ravh_sim.world.facing import OPENING_FRONT, choose_facing, front_axis, suits_box
 from ravh_sim.world.furniture import build_parts, variant_count
 from ravh_sim.world.geometry import box_corners
@@ -40,6 +41,11 @@ DOOR_LEAF_THICKNESS = 0.05
 JAMB_COLOUR = "white"
 _Y = np.array([0.0, 1.0, 0.0])             # a door body's axis along the doorway
 MAX_FOOTPRINT_BOXES = 48                   # a library model's floor footprint: its largest pieces' boxes
+APPLIANCE_LEAST_WIDTH_SCALE = 0.85
+"""Least scale of an appliance model's front width (``OPENING_FRONT``): appliances are built in standard
+widths, so a model squeezed further reads as another appliance (a 93 cm side-by-side fridge fitted to a
+63 cm combi's box has 30 cm doors, named "shoji" or "prison" by an ImageNet classifier). Models that
+fit without it rank first; a box none fits takes the best proportions as before."""
 
 Footprint = tuple[tuple[float, float], tuple[float, float], float]
 """A yawed rectangle on the floor: centre (x, y), size (along yaw, across), yaw."""
@@ -154,13 +160,24 @@ def object_parts(house: House, obj: HouseObject, model: int | None) -> Placed:
     walls = tuple((w.a, w.b) for w in house.walls if w.room == obj.room and w.kind != "lintel")
     facing = _facing(tuple(box.position[:2]), obj.yaw, tuple(box.size), walls, front_axis(obj.type),
                      _blockers(house, obj))
-    records = library.models_of(library.kind_of(obj.type, obj.prefab))
+    records = _models_of(obj)
     if records:
         record, facing = _library_choice(records, variant, np.asarray(box.size), facing, front_axis(obj.type))
         fitted, bounds = _fitted(record.id, tuple(box.size), facing)
         return Placed((), bounds, box.position, obj.yaw, fitted, obj.yaw + facing * math.pi / 2)
     parts, bounds = _parts(obj.type, tuple(box.size), variant, facing, obj.prefab)
     return Placed(parts, bounds, box.position, obj.yaw)
+
+
+def _models_of(obj: HouseObject) -> tuple[library.LibraryRecord, ...]:
+    """The models an object's variants choose among: its kind's library models; for a picture, the wall
+    art made here (:mod:`ravh_sim.world.made_art`), each picture starting at its own (seeded by where
+    it hangs: the houses' pictures all name upstream model 0)."""
+    if obj.type != "Picture":
+        return library.models_of(library.kind_of(obj.type, obj.prefab))
+    art = made_art.records(made_art.KIND)
+    start = zlib.crc32(f"{obj.id}/{np.round(obj.position, 3).tolist()}".encode()) % len(art)
+    return art[start:] + art[:start]
 
 
 def _library_choice(records: tuple[library.LibraryRecord, ...], variant: int, size: np.ndarray, facing: int,
@@ -172,19 +189,26 @@ def _library_choice(records: tuple[library.LibraryRecord, ...], variant: int, si
         facing = (facing + 1) % 4
     facings = (facing, (facing + 1) % 4) if front == "any" else (facing,)
 
-    def misfit(record: library.LibraryRecord, f: int) -> float:
-        return library.misfit(np.asarray(record.size), size[[0, 1, 2] if f % 2 == 0 else [1, 0, 2]])
+    def box_for(f: int) -> np.ndarray:
+        return size[[0, 1, 2] if f % 2 == 0 else [1, 0, 2]]
 
-    ranked = sorted(records, key=lambda r: min(misfit(r, f) for f in facings))
+    def misfit(record: library.LibraryRecord, f: int) -> float:
+        return library.misfit(np.asarray(record.size), box_for(f))
+
+    def squeezed(record: library.LibraryRecord) -> bool:    # front width: the model's y (its front is +x)
+        return front == "door" and box_for(facing)[1] < APPLIANCE_LEAST_WIDTH_SCALE * record.size[1]
+
+    ranked = sorted(records, key=lambda r: (squeezed(r), min(misfit(r, f) for f in facings)))
     record = ranked[variant % len(ranked)]
     return record, min(facings, key=lambda f: misfit(record, f))
 
 
 def model_count(obj: HouseObject) -> int:
     """How many models the Object Models setting chooses among for ``obj``: its kind's library
-    models, or the procedural variants of its type, after the house's own model where it has one."""
+    models (a picture's: the wall art made here), or the procedural variants of its type, after the
+    house's own model where it has one."""
     own = obj.own_model is not None
-    return own + (len(library.models_of(library.kind_of(obj.type, obj.prefab))) or variant_count(obj.type))
+    return own + (len(_models_of(obj)) or variant_count(obj.type))
 
 
 def door_parts(house: House, door: Door, model: int | None) -> Placed:
@@ -220,11 +244,11 @@ def _parts(object_type: str, size: tuple[float, float, float], variant: int, fac
 @functools.lru_cache(maxsize=1024)
 def _fitted(model_id: str, size: tuple[float, float, float], facing: int
             ) -> tuple[trimesh.Trimesh, np.ndarray]:
-    """A library model fitted into a box (turned to ``facing`` as procedural models are) and the
-    boxes of its largest pieces, cached like :func:`_parts`."""
+    """A library model (or wall art made to the box) fitted into a box (turned to ``facing`` as
+    procedural models are) and the boxes of its largest pieces, cached like :func:`_parts`."""
     extents = np.asarray(size, np.float64)
     d, w, h = extents[[0, 1, 2] if facing % 2 == 0 else [1, 0, 2]]
-    model = library.load_model(model_id)
+    model = made_art.model(model_id, (d, w, h)) if made_art.is_made(model_id) else library.load_model(model_id)
     turn = trimesh.transformations.rotation_matrix(facing * np.pi / 2, (0, 0, 1))[:3, :3]
     vertices = library.fit(model, np.array([d, w, h])) @ turn.T
     return library.with_vertices(model, vertices), _piece_bounds(vertices, model.faces, model.face_attributes["piece"])
