@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 from test_sensors import PROFILE, _world, gl_box_world, restored_appearance
 
+from ravh_sim.look.geometry import corner_normals
 from ravh_sim.look.lighting import outdoors, sun_light
 from ravh_sim.look.materials import noise_volume
 from ravh_sim.sensors.camera import CameraOptions, SmartCamera
@@ -235,3 +236,22 @@ def test_dataset_quality_draws_the_same_instances_at_the_same_pixels():
     same = ~differ & np.isfinite(live.depth) & np.isfinite(detailed.depth)
     assert np.percentile(np.abs(live.depth[same] - detailed.depth[same]), 95) < 0.01
     assert not np.array_equal(live.rgb, detailed.rgb)
+
+
+def test_shading_normals_smooth_split_vertices_and_keep_creases():
+    """A sphere whose every triangle has its own vertices (as a library model's upholstery, split at
+    its seams) shades as smooth as the sphere with shared vertices where its faces are welded (soft
+    models), as facets where not (a split is a hard edge); a welded cube keeps its flat faces however
+    its sides are cut into triangles."""
+    import trimesh
+    sphere = trimesh.creation.icosphere(subdivisions=2)
+    split = sphere.vertices[sphere.faces].reshape(-1, 3), np.arange(3 * len(sphere.faces)).reshape(-1, 3)
+    every = np.ones(len(sphere.faces), bool)
+    smooth = corner_normals(*split, every)
+    assert np.allclose(smooth, corner_normals(sphere.vertices, sphere.faces, every), atol=1e-9)
+    radial = split[0] / np.linalg.norm(split[0], axis=1, keepdims=True)
+    assert np.einsum("ij,ij->i", smooth, radial).min() > 0.999
+    assert np.allclose(corner_normals(*split), np.repeat(sphere.face_normals, 3, axis=0), atol=1e-9)
+    cube = trimesh.creation.box((1.0, 1.0, 1.0))
+    cube_n = corner_normals(cube.vertices, cube.faces, np.ones(len(cube.faces), bool))
+    assert np.allclose(cube_n, np.repeat(cube.face_normals, 3, axis=0), atol=1e-9)

@@ -28,6 +28,10 @@ FLOATS_PER_VERTEX = 13                       # position 3, normal 3, local 3, ma
 VERTEX_FORMAT = "3f 3f 3f 1f 1f 2f"
 ATTRIBUTES = ("in_position", "in_normal", "in_local", "in_material", "in_instance", "in_uv")
 CREASE_COS = math.cos(math.radians(40.0))    # corners bent less than this share a smooth normal
+WELD_DECIMALS = 5                            # corners this close (10 um) are one place for smoothing
+SOFT_MODELS = ("Armchair", "Sofa", "Bed", "Toilet", "Washbasin", "Sink", "Bathtub")
+"""Library kinds shaded smooth across their split vertices: upholstery and moulded ceramics, decimated
+into facets that their authors' seams left unwelded (hard furniture keeps its authors' edges)."""
 
 
 @dataclass(frozen=True)
@@ -50,21 +54,50 @@ def model_arrays(fitted: trimesh.Trimesh, slots: np.ndarray) -> BodyArrays:
     """Corners, normals, material slots (``slots[k]``: the table index of the model's material k)
     and texture coordinates of a fitted library model."""
     faces = fitted.faces
-    return BodyArrays(fitted.vertices[faces.ravel()], corner_normals(fitted.vertices, faces),
-                      np.repeat(slots[library.face_material(fitted)], 3), fitted.visual.uv[faces.ravel()])
+    material = library.face_material(fitted)
+    soft = np.full(len(faces), library.record(fitted).kind.split("/")[0] in SOFT_MODELS)
+    return BodyArrays(fitted.vertices[faces.ravel()], corner_normals(fitted.vertices, faces, soft),
+                      np.repeat(slots[material], 3), fitted.visual.uv[faces.ravel()])
 
 
-def corner_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(3F, 3) normals: smooth across gentle bends, flat across creases (CREASE_COS)."""
+def corner_normals(vertices: np.ndarray, faces: np.ndarray, welded: np.ndarray | None = None) -> np.ndarray:
+    """(3F, 3) normals: smooth across gentle bends, flat across creases (CREASE_COS). A split vertex
+    is a hard edge (the model's author put it there: a cabinet door's raised panel), and each corner
+    takes its vertex's mean normal unless its face bends away from it. ``welded`` (per face) are
+    soft faces (:data:`SOFT_MODELS`), whose split vertices are seams, not edges (an armchair's 368
+    places have 1,600 vertices, and its upholstery had shaded as facets): their corners at one place
+    share the mean of the faces there that bend less than CREASE_COS from their own (so a box's corner
+    stays a crease however its sides are cut into triangles), weighted by the faces' angles there."""
     face_n, valid = trimesh.triangles.normals(vertices[faces])
     face_n = _scatter(face_n, valid, len(faces))
+    corner_face_n = np.repeat(face_n, 3, axis=0)
     summed = np.zeros((len(vertices), 3))
     np.add.at(summed, faces, face_n[:, None, :])            # trimesh's mean without scipy.sparse
-    vertex_n = trimesh.util.unitize(summed)
-    corner_face_n = np.repeat(face_n, 3, axis=0)
-    corner_vertex_n = vertex_n[faces.ravel()]
+    corner_vertex_n = trimesh.util.unitize(summed)[faces.ravel()]
     smooth = np.einsum("ij,ij->i", corner_face_n, corner_vertex_n) > CREASE_COS
-    return np.where(smooth[:, None], corner_vertex_n, corner_face_n)
+    normals = np.where(smooth[:, None], corner_vertex_n, corner_face_n)
+    if welded is not None and np.any(welded):
+        soft = np.repeat(np.asarray(welded, bool), 3)
+        normals[soft] = _welded_normals(vertices, faces, face_n)[soft]
+    return normals
+
+
+def _welded_normals(vertices: np.ndarray, faces: np.ndarray, face_n: np.ndarray) -> np.ndarray:
+    """(3F, 3) per-corner smoothing groups over places (see :func:`corner_normals`)."""
+    weight = np.nan_to_num(trimesh.triangles.angles(vertices[faces])).ravel()
+    _, place = np.unique(np.round(vertices, WELD_DECIMALS), axis=0, return_inverse=True)
+    corner_place = place.reshape(-1)[faces].ravel()
+    corner_n = np.repeat(face_n, 3, axis=0)
+    order = np.argsort(corner_place, kind="stable")          # every pair of corners at one place
+    counts = np.bincount(corner_place)[corner_place[order]]
+    first = np.searchsorted(corner_place[order], corner_place[order])
+    rows = np.repeat(np.arange(len(order)), counts)
+    step = np.arange(len(rows)) - np.repeat(np.cumsum(counts) - counts, counts)
+    corner, other = order[rows], order[first[rows] + step]
+    near = np.einsum("ij,ij->i", corner_n[corner], corner_n[other]) > CREASE_COS
+    summed = np.zeros((len(corner_n), 3))
+    np.add.at(summed, corner[near], corner_n[other[near]] * weight[other[near], None])
+    return np.where(np.linalg.norm(summed, axis=1)[:, None] > 0, trimesh.util.unitize(summed), corner_n)
 
 
 def _scatter(normals: np.ndarray, valid: np.ndarray, count: int) -> np.ndarray:
