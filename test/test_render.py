@@ -246,12 +246,11 @@ def test_shading_normals_smooth_split_vertices_and_keep_creases():
     import trimesh
     sphere = trimesh.creation.icosphere(subdivisions=2)
     split = sphere.vertices[sphere.faces].reshape(-1, 3), np.arange(3 * len(sphere.faces)).reshape(-1, 3)
-    every = np.ones(len(sphere.faces), bool)
-    smooth = corner_normals(*split, every)
-    assert np.allclose(smooth, corner_normals(sphere.vertices, sphere.faces, every), atol=1e-9)
+    smooth = corner_normals(*split, welded=True)
+    assert np.allclose(smooth, corner_normals(sphere.vertices, sphere.faces, welded=True), atol=1e-9)
     radial = split[0] / np.linalg.norm(split[0], axis=1, keepdims=True)
     assert np.einsum("ij,ij->i", smooth, radial).min() > 0.999
     assert np.allclose(corner_normals(*split), np.repeat(sphere.face_normals, 3, axis=0), atol=1e-9)
     cube = trimesh.creation.box((1.0, 1.0, 1.0))
-    cube_n = corner_normals(cube.vertices, cube.faces, np.ones(len(cube.faces), bool))
+    cube_n = corner_normals(cube.vertices, cube.faces, welded=True)
     assert np.allclose(cube_n, np.repeat(cube.face_normals, 3, axis=0), atol=1e-9)

@@ -55,31 +55,29 @@ def model_arrays(fitted: trimesh.Trimesh, slots: np.ndarray) -> BodyArrays:
     and texture coordinates of a fitted library model."""
     faces = fitted.faces
     material = library.face_material(fitted)
-    soft = np.full(len(faces), library.record(fitted).kind.split("/")[0] in SOFT_MODELS)
+    soft = library.record(fitted).kind.split("/")[0] in SOFT_MODELS
     return BodyArrays(fitted.vertices[faces.ravel()], corner_normals(fitted.vertices, faces, soft),
                       np.repeat(slots[material], 3), fitted.visual.uv[faces.ravel()])
 
 
-def corner_normals(vertices: np.ndarray, faces: np.ndarray, welded: np.ndarray | None = None) -> np.ndarray:
+def corner_normals(vertices: np.ndarray, faces: np.ndarray, welded: bool = False) -> np.ndarray:
     """(3F, 3) normals: smooth across gentle bends, flat across creases (CREASE_COS). A split vertex
     is a hard edge (the model's author put it there: a cabinet door's raised panel), and each corner
-    takes its vertex's mean normal unless its face bends away from it. ``welded`` (per face) are
-    soft faces (:data:`SOFT_MODELS`), whose split vertices are seams, not edges (an armchair's 368
+    takes its vertex's mean normal unless its face bends away from it. A ``welded`` model is soft
+    (:data:`SOFT_MODELS`): its split vertices are seams, not edges (an armchair's 368
     places have 1,600 vertices, and its upholstery had shaded as facets): their corners at one place
     share the mean of the faces there that bend less than CREASE_COS from their own (so a box's corner
     stays a crease however its sides are cut into triangles), weighted by the faces' angles there."""
     face_n, valid = trimesh.triangles.normals(vertices[faces])
     face_n = _scatter(face_n, valid, len(faces))
+    if welded:
+        return _welded_normals(vertices, faces, face_n)
     corner_face_n = np.repeat(face_n, 3, axis=0)
     summed = np.zeros((len(vertices), 3))
     np.add.at(summed, faces, face_n[:, None, :])            # trimesh's mean without scipy.sparse
     corner_vertex_n = trimesh.util.unitize(summed)[faces.ravel()]
     smooth = np.einsum("ij,ij->i", corner_face_n, corner_vertex_n) > CREASE_COS
-    normals = np.where(smooth[:, None], corner_vertex_n, corner_face_n)
-    if welded is not None and np.any(welded):
-        soft = np.repeat(np.asarray(welded, bool), 3)
-        normals[soft] = _welded_normals(vertices, faces, face_n)[soft]
-    return normals
+    return np.where(smooth[:, None], corner_vertex_n, corner_face_n)
 
 
 def _welded_normals(vertices: np.ndarray, faces: np.ndarray, face_n: np.ndarray) -> np.ndarray:
