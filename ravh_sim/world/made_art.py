@@ -275,7 +275,7 @@ def model(model_id: str, size: tuple[float, float, float]) -> trimesh.Trimesh:
     picture = fitted[before:, 1:3]
     lo, hi = picture.min(axis=0), picture.max(axis=0)
     uv[before:] = (picture - lo) / np.maximum(hi - lo, 1e-9)
-    entry = _record(variant, (float(d), float(w), float(h)))
+    entry = records(KIND)[variant].model_copy(update={"size": (float(d), float(w), float(h))})
     return library.made_model(fitted, np.vstack(parts.faces), uv, entry, np.concatenate(parts.materials),
                               np.concatenate(parts.pieces))
 
